@@ -1,0 +1,40 @@
+#pragma once
+// An input image prepared for tracking and mapping.
+
+#include <cstdint>
+
+#include "core/image.hpp"
+#include "core/image_pyramid.hpp"
+#include "core/pinhole_camera.hpp"
+
+namespace parallax {
+
+/// One camera frame in the engine's ideal pinhole camera: id, timestamp and the intensity
+/// pyramid with gradients. Immutable after construction, so it can be shared between
+/// threads as std::shared_ptr<const Frame>.
+class Frame {
+ public:
+  /// `image` must already be undistorted to `camera` (same size); `timestamp` in seconds as
+  /// given by the input. Throws std::invalid_argument for an empty image, a size mismatch or a
+  /// non-finite timestamp.
+  Frame(std::int64_t id, double timestamp, const PinholeCamera& camera, const ImageU8& image,
+        const PyramidOptions& pyramid_options = {});
+
+  std::int64_t Id() const { return id_; }
+  double Timestamp() const { return timestamp_; }
+  const ImagePyramid& Pyramid() const { return pyramid_; }
+  int NumLevels() const { return pyramid_.NumLevels(); }
+  const PyramidLevel& Level(int level) const { return pyramid_.Level(level); }
+  /// Camera of pyramid level `level` (see PinholeCamera::AtLevel).
+  const PinholeCamera& Camera(int level = 0) const {
+    return cameras_[static_cast<std::size_t>(level)];
+  }
+
+ private:
+  std::int64_t id_;
+  double timestamp_;
+  ImagePyramid pyramid_;
+  std::vector<PinholeCamera> cameras_;
+};
+
+}  // namespace parallax

@@ -1,0 +1,156 @@
+#include "core/image_pyramid.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "core/check.hpp"
+
+namespace parallax {
+namespace {
+
+// Raw, writable plane inside the pyramid buffer (construction only).
+struct Plane {
+  float* data;
+  int width;
+  int height;
+  float* Row(int y) const { return data + static_cast<std::ptrdiff_t>(y) * width; }
+};
+
+void ConvertToFloat(const ImageView<std::uint8_t>& image, const Plane& out) {
+  const std::uint8_t* src = image.Data();
+  const std::size_t n = image.NumPixels();
+  for (std::size_t i = 0; i < n; ++i) out.data[i] = static_cast<float>(src[i]);
+}
+
+void Downsample2x2(const Plane& fine, const Plane& coarse) {
+  for (int y = 0; y < coarse.height; ++y) {
+    const float* r0 = fine.Row(2 * y);
+    const float* r1 = fine.Row(2 * y + 1);
+    float* dst = coarse.Row(y);
+    for (int x = 0; x < coarse.width; ++x) {
+      dst[x] = 0.25f * (r0[2 * x] + r0[2 * x + 1] + r1[2 * x] + r1[2 * x + 1]);
+    }
+  }
+}
+
+void ZeroRow(const Plane& plane, int y) { std::fill_n(plane.Row(y), plane.width, 0.0f); }
+
+void ComputeGradients(const Plane& I, const Plane& dx, const Plane& dy, const Plane& g2) {
+  const int w = I.width;
+  const int h = I.height;
+  for (const Plane* p : {&dx, &dy, &g2}) {
+    ZeroRow(*p, 0);
+    ZeroRow(*p, h - 1);
+  }
+  for (int y = 1; y < h - 1; ++y) {
+    const float* __restrict up = I.Row(y - 1);
+    const float* __restrict mid = I.Row(y);
+    const float* __restrict down = I.Row(y + 1);
+    float* __restrict gx_row = dx.Row(y);
+    float* __restrict gy_row = dy.Row(y);
+    float* __restrict g2_row = g2.Row(y);
+    gx_row[0] = gy_row[0] = g2_row[0] = 0.0f;
+    gx_row[w - 1] = gy_row[w - 1] = g2_row[w - 1] = 0.0f;
+    for (int x = 1; x < w - 1; ++x) {
+      const float gx = 0.5f * (mid[x + 1] - mid[x - 1]);
+      const float gy = 0.5f * (down[x] - up[x]);
+      gx_row[x] = gx;
+      gy_row[x] = gy;
+      g2_row[x] = gx * gx + gy * gy;
+    }
+  }
+}
+
+}  // namespace
+
+void PyramidOptions::Check() const {
+  CheckOption(max_levels >= 1 && max_levels <= 16, "PyramidOptions", "max_levels",
+              "must be in [1, 16], got " + std::to_string(max_levels));
+  CheckOption(min_level_size >= 2, "PyramidOptions", "min_level_size",
+              "must be >= 2, got " + std::to_string(min_level_size));
+}
+
+int NumPyramidLevels(int width, int height, const PyramidOptions& options) {
+  options.Check();
+  int levels = 1;
+  while (levels < options.max_levels && (width >> levels) >= options.min_level_size &&
+         (height >> levels) >= options.min_level_size) {
+    ++levels;
+  }
+  return levels;
+}
+
+ImagePyramid::ImagePyramid(const ImageView<std::uint8_t>& image, const PyramidOptions& options) {
+  CheckArgument(!image.Empty(), "ImagePyramid: the input image is empty");
+  const int num_levels = NumPyramidLevels(image.Width(), image.Height(), options);
+  constexpr std::size_t kPlanes = 4;  // intensity, dx, dy, grad_sq
+  std::vector<std::size_t> offsets;
+  std::size_t total = 0;
+  for (int l = 0; l < num_levels; ++l) {
+    offsets.push_back(total);
+    total += kPlanes * static_cast<std::size_t>(image.Width() >> l) *
+             static_cast<std::size_t>(image.Height() >> l);
+  }
+  // Every element is written below, so skip value-initialisation.
+  buffer_ = std::make_unique_for_overwrite<float[]>(total);
+  std::vector<std::array<Plane, kPlanes>> planes(static_cast<std::size_t>(num_levels));
+  for (std::size_t l = 0; l < planes.size(); ++l) {
+    const int w = image.Width() >> l;
+    const int h = image.Height() >> l;
+    const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+    for (std::size_t p = 0; p < kPlanes; ++p) planes[l][p] = Plane{buffer_.get() + offsets[l] + p * n, w, h};
+  }
+  ConvertToFloat(image, planes[0][0]);
+  for (std::size_t l = 1; l < planes.size(); ++l) Downsample2x2(planes[l - 1][0], planes[l][0]);
+  levels_.reserve(planes.size());
+  for (const auto& level : planes) {
+    ComputeGradients(level[0], level[1], level[2], level[3]);
+    const auto view = [](const Plane& p) { return ImageViewF(p.data, p.width, p.height); };
+    levels_.push_back(PyramidLevel{view(level[0]), view(level[1]), view(level[2]), view(level[3])});
+  }
+}
+
+ImageF MaxGradient3x3(const PyramidLevel& level) {
+  const int w = level.Width();
+  const int h = level.Height();
+  ImageF magnitude(w, h);
+  for (std::size_t i = 0; i < magnitude.NumPixels(); ++i) {
+    magnitude.Data()[i] = std::sqrt(level.grad_sq.Data()[i]);
+  }
+  // Separable max filter: horizontal then vertical, clamped at the border.
+  ImageF horizontal(w, h);
+  for (int y = 0; y < h; ++y) {
+    const float* src = magnitude.Row(y);
+    float* dst = horizontal.Row(y);
+    for (int x = 0; x < w; ++x) {
+      dst[x] = std::max({src[std::max(x - 1, 0)], src[x], src[std::min(x + 1, w - 1)]});
+    }
+  }
+  ImageF out(w, h);
+  for (int y = 0; y < h; ++y) {
+    const float* up = horizontal.Row(std::max(y - 1, 0));
+    const float* mid = horizontal.Row(y);
+    const float* down = horizontal.Row(std::min(y + 1, h - 1));
+    float* dst = out.Row(y);
+    for (int x = 0; x < w; ++x) dst[x] = std::max({up[x], mid[x], down[x]});
+  }
+  return out;
+}
+
+std::vector<int> SelectSemiDensePixels(const PyramidLevel& level, float min_gradient, int border) {
+  CheckArgument(border >= 0, "SelectSemiDensePixels: border must be >= 0");
+  CheckArgument(std::isfinite(min_gradient), "SelectSemiDensePixels: min_gradient must be finite");
+  const ImageF max_gradient = MaxGradient3x3(level);
+  std::vector<int> indices;
+  const int w = level.Width();
+  for (int y = border; y < level.Height() - border; ++y) {
+    const float* row = max_gradient.Row(y);
+    for (int x = border; x < w - border; ++x) {
+      if (row[x] >= min_gradient) indices.push_back(y * w + x);
+    }
+  }
+  return indices;
+}
+
+}  // namespace parallax

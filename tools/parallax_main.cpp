@@ -1,0 +1,34 @@
+// The `parallax` command: one executable, one subcommand per user job (docs/cli.md).
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
+namespace {
+
+int RunDemo() {
+  std::fprintf(stderr,
+               "parallax demo: the visual-odometry pipeline is not implemented yet; this build "
+               "provides the core library (geometry, cameras, pyramids) only.\n");
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Parallax: direct semi-dense monocular SLAM"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", PARALLAX_VERSION);
+  CLI::App* demo = app.add_subcommand("demo", "Run the pipeline on a built-in synthetic sequence");
+  int exit_code = 0;
+  demo->callback([&] { exit_code = RunDemo(); });
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "parallax: %s\n", e.what());
+    return 1;
+  }
+  return exit_code;
+}
