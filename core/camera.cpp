@@ -45,8 +45,8 @@ CameraModel CameraModelFromString(const std::string& name) {
                               "' (expected pinhole, radtan, equidistant or fov)");
 }
 
-Camera::Camera(CameraModel model, int width, int height, double fx, double fy, double cx,
-               double cy, std::vector<double> distortion)
+Camera::Camera(CameraModel model, int width, int height, double fx, double fy, double cx, double cy,
+               std::vector<double> distortion)
     : model_(model),
       intrinsics_(width, height, fx, fy, cx, cy),
       distortion_(std::move(distortion)) {
@@ -60,9 +60,9 @@ Camera::Camera(CameraModel model, int width, int height, double fx, double fy, d
                   "Camera: distortion parameter " + std::to_string(i) + " is not finite");
   }
   if (model == CameraModel::kFov) {
-    CheckArgument(distortion_[0] > 0.0 && distortion_[0] < std::numbers::pi,
-                  "Camera: FOV omega must be in (0, pi) radians, got " +
-                      std::to_string(distortion_[0]));
+    CheckArgument(
+        distortion_[0] > 0.0 && distortion_[0] < std::numbers::pi,
+        "Camera: FOV omega must be in (0, pi) radians, got " + std::to_string(distortion_[0]));
   }
 }
 
@@ -166,10 +166,12 @@ Eigen::Matrix2d Camera::DistortJacobian(const Eigen::Vector2d& x) const {
       const double radial = 1.0 + r2 * (d[0] + r2 * (d[1] + r2 * d[4]));
       const double dradial_dr2 = d[0] + r2 * (2.0 * d[1] + 3.0 * r2 * d[4]);
       Eigen::Matrix2d J;
-      J(0, 0) = radial + 2.0 * x.x() * x.x() * dradial_dr2 + 2.0 * d[2] * x.y() + 6.0 * d[3] * x.x();
+      J(0, 0) =
+          radial + 2.0 * x.x() * x.x() * dradial_dr2 + 2.0 * d[2] * x.y() + 6.0 * d[3] * x.x();
       J(0, 1) = 2.0 * x.x() * x.y() * dradial_dr2 + 2.0 * d[2] * x.x() + 2.0 * d[3] * x.y();
       J(1, 0) = 2.0 * x.x() * x.y() * dradial_dr2 + 2.0 * d[2] * x.x() + 2.0 * d[3] * x.y();
-      J(1, 1) = radial + 2.0 * x.y() * x.y() * dradial_dr2 + 6.0 * d[2] * x.y() + 2.0 * d[3] * x.x();
+      J(1, 1) =
+          radial + 2.0 * x.y() * x.y() * dradial_dr2 + 6.0 * d[2] * x.y() + 2.0 * d[3] * x.x();
       return J;
     }
     case CameraModel::kEquidistant:

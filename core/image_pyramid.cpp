@@ -99,7 +99,8 @@ ImagePyramid::ImagePyramid(const ImageView<std::uint8_t>& image, const PyramidOp
     const int w = image.Width() >> l;
     const int h = image.Height() >> l;
     const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-    for (std::size_t p = 0; p < kPlanes; ++p) planes[l][p] = Plane{buffer_.get() + offsets[l] + p * n, w, h};
+    for (std::size_t p = 0; p < kPlanes; ++p)
+      planes[l][p] = Plane{buffer_.get() + offsets[l] + p * n, w, h};
   }
   ConvertToFloat(image, planes[0][0]);
   for (std::size_t l = 1; l < planes.size(); ++l) Downsample2x2(planes[l - 1][0], planes[l][0]);

@@ -18,7 +18,7 @@ struct GaussLegendreRule {
 // classical cosine initial guess; weights 2 / ((1 - x^2) P_n'(x)^2), mapped from [-1, 1].
 GaussLegendreRule MakeGaussLegendreRule() {
   GaussLegendreRule rule;
-  constexpr int n = kQuadratureNodes;
+  const int n = kQuadratureNodes;
   for (int i = 0; i < n; ++i) {
     double x = std::cos(std::numbers::pi * (i + 0.75) / (n + 0.5));
     double derivative = 1.0;

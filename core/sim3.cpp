@@ -22,8 +22,7 @@ template <typename Scalar>
 Sim3<Scalar>::Sim3(Scalar scale, const SO3<Scalar>& rotation, const Vector3& translation)
     : scale_(scale), rotation_(rotation), translation_(translation) {
   if (!std::isfinite(scale) || !(scale > Scalar(0))) {
-    throw std::invalid_argument("Sim3: scale must be finite and > 0, got " +
-                                std::to_string(scale));
+    throw std::invalid_argument("Sim3: scale must be finite and > 0, got " + std::to_string(scale));
   }
   if (!translation.allFinite()) throw std::invalid_argument("Sim3: translation must be finite");
 }

@@ -22,11 +22,14 @@ template <typename Scalar>
 SO3<Scalar>::SO3(const Matrix3& R) {
   const double tolerance = sizeof(Scalar) == sizeof(float) ? 1e-4 : 1e-8;
   const Eigen::Matrix3d Rd = R.template cast<double>();
-  const double orthogonality = (Rd.transpose() * Rd - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  const double orthogonality =
+      (Rd.transpose() * Rd - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   const double det = Rd.determinant();
-  if (!std::isfinite(orthogonality) || orthogonality > tolerance || std::abs(det - 1.0) > tolerance) {
-    throw std::invalid_argument("SO3: matrix is not a rotation (max |R^T R - I| = " +
-                                std::to_string(orthogonality) + ", det = " + std::to_string(det) + ")");
+  if (!std::isfinite(orthogonality) || orthogonality > tolerance ||
+      std::abs(det - 1.0) > tolerance) {
+    throw std::invalid_argument(
+        "SO3: matrix is not a rotation (max |R^T R - I| = " + std::to_string(orthogonality) +
+        ", det = " + std::to_string(det) + ")");
   }
   q_ = Quaternion(R).normalized();
 }

@@ -11,10 +11,10 @@
 namespace parallax {
 
 struct Undistorter::Maps {
-  cv::Mat map_x;      // CV_32FC1, source x per output pixel (-1 where invalid)
-  cv::Mat map_y;      // CV_32FC1
-  cv::Mat fixed_xy;   // CV_16SC2, fixed-point form of the same maps used by cv::remap
-  cv::Mat fixed_frac; // CV_16UC1 interpolation table indices
+  cv::Mat map_x;       // CV_32FC1, source x per output pixel (-1 where invalid)
+  cv::Mat map_y;       // CV_32FC1
+  cv::Mat fixed_xy;    // CV_16SC2, fixed-point form of the same maps used by cv::remap
+  cv::Mat fixed_frac;  // CV_16UC1 interpolation table indices
 };
 
 namespace {
@@ -45,7 +45,7 @@ Rect UndistortedBorderBox(const Camera& camera) {
   for (int i = 0; i <= samples; ++i) {
     const double s = static_cast<double>(i) / samples;
     for (const Eigen::Vector2d& uv : {Eigen::Vector2d(s * w, 0.0), Eigen::Vector2d(s * w, h),
-                                     Eigen::Vector2d(0.0, s * h), Eigen::Vector2d(w, s * h)}) {
+                                      Eigen::Vector2d(0.0, s * h), Eigen::Vector2d(w, s * h)}) {
       const auto ray = camera.Unproject(uv);
       if (!ray) continue;
       any = true;
@@ -153,8 +153,8 @@ Undistorter::Undistorter(const Camera& input, const UndistorterOptions& options)
     auto* my = maps_->map_y.ptr<float>(y);
     for (int x = 0; x < output_.Width(); ++x) {
       const auto uv = input.Project(output_.Unproject(Eigen::Vector2d(x, y)));
-      const bool valid = uv && uv->x() > -0.5 && uv->y() > -0.5 &&
-                         uv->x() < input.Width() - 0.5 && uv->y() < input.Height() - 0.5;
+      const bool valid = uv && uv->x() > -0.5 && uv->y() > -0.5 && uv->x() < input.Width() - 0.5 &&
+                         uv->y() < input.Height() - 0.5;
       mx[x] = valid ? static_cast<float>(uv->x()) : -1.0f;
       my[x] = valid ? static_cast<float>(uv->y()) : -1.0f;
     }
@@ -179,7 +179,8 @@ void Undistorter::Apply(const ImageU8& image, ImageU8* output) const {
     return;
   }
   // cv::Mat headers over our buffers: no copies.
-  const cv::Mat src(image.Height(), image.Width(), CV_8UC1, const_cast<std::uint8_t*>(image.Data()));
+  const cv::Mat src(image.Height(), image.Width(), CV_8UC1,
+                    const_cast<std::uint8_t*>(image.Data()));
   cv::Mat dst(output->Height(), output->Width(), CV_8UC1, output->Data());
   cv::remap(src, dst, maps_->fixed_xy, maps_->fixed_frac, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
             cv::Scalar(0));

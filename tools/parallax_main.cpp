@@ -13,9 +13,7 @@ int RunDemo() {
   return 2;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int Run(int argc, char** argv) {
   CLI::App app{"Parallax: direct semi-dense monocular SLAM"};
   app.require_subcommand(1);
   app.set_version_flag("--version", PARALLAX_VERSION);
@@ -26,9 +24,20 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "parallax: %s\n", e.what());
-    return 1;
   }
   return exit_code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Every error reaches the user as one line on stderr and a non-zero exit, never a crash.
+  try {
+    return Run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "parallax: %s\n", e.what());
+  } catch (...) {
+    std::fprintf(stderr, "parallax: unknown error\n");
+  }
+  return 1;
 }

@@ -22,13 +22,17 @@ ImageU8 RandomImage(int w, int h) {
 }
 
 void BM_PyramidWithGradients(benchmark::State& state) {
-  const ImageU8 image = RandomImage(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const ImageU8 image =
+      RandomImage(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   for (auto _ : state) {
     ImagePyramid pyramid(image, PyramidOptions{});
     benchmark::DoNotOptimize(pyramid.Level(pyramid.NumLevels() - 1).grad_sq.Data());
   }
 }
-BENCHMARK(BM_PyramidWithGradients)->Args({640, 480})->Args({1226, 370})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_PyramidWithGradients)
+    ->Args({640, 480})
+    ->Args({1226, 370})
+    ->Unit(benchmark::kMicrosecond);
 
 void BM_Undistort(benchmark::State& state) {
   const int w = static_cast<int>(state.range(0));

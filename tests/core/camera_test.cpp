@@ -1,8 +1,9 @@
 // Camera models: projection round trips, Jacobians, pyramid-level cameras, invalid input.
 
+#include "core/camera.hpp"
+
 #include <gtest/gtest.h>
 
-#include "core/camera.hpp"
 #include "core/pinhole_camera.hpp"
 #include "tests/core/lie_test_utils.hpp"
 
@@ -56,15 +57,16 @@ TEST_P(CameraModelTest, UnprojectProjectRoundTripOverImage) {
     }
   }
   // The whole image must be invertible for these lenses except perhaps extreme corners.
-  EXPECT_GT(checked, 0.95 * (camera.Width() / 16) * (camera.Height() / 16));
+  const int grid_points = (camera.Width() / 16) * (camera.Height() / 16);
+  EXPECT_GT(checked, 0.95 * grid_points);
 }
 
 TEST_P(CameraModelTest, DistortJacobianMatchesNumeric) {
   const Camera camera = MakeCamera();
   for (const Eigen::Vector2d& x : {Eigen::Vector2d(0, 0), Eigen::Vector2d(1e-7, -2e-7),
-                                  Eigen::Vector2d(0.2, -0.1), Eigen::Vector2d(-0.5, 0.4)}) {
-    const Eigen::Matrix2d numeric = NumericJacobian<2, 2>(
-        [&](const Eigen::Vector2d& p) { return camera.Distort(p); }, x, 1e-7);
+                                   Eigen::Vector2d(0.2, -0.1), Eigen::Vector2d(-0.5, 0.4)}) {
+    const Eigen::Matrix2d numeric =
+        NumericJacobian<2, 2>([&](const Eigen::Vector2d& p) { return camera.Distort(p); }, x, 1e-7);
     EXPECT_LT((camera.DistortJacobian(x) - numeric).norm(), 1e-6)
         << camera.ToString() << " at " << x.transpose();
   }
@@ -81,8 +83,8 @@ INSTANTIATE_TEST_SUITE_P(AllModels, CameraModelTest, ::testing::Values(0, 1, 2, 
 TEST(PinholeCamera, ProjectJacobianMatchesNumeric) {
   const PinholeCamera camera(640, 480, 500, 510, 320, 240);
   const Eigen::Vector3d p(0.3, -0.2, 1.7);
-  const auto numeric = NumericJacobian<2, 3>(
-      [&](const Eigen::Vector3d& q) { return camera.Project(q); }, p);
+  const auto numeric =
+      NumericJacobian<2, 3>([&](const Eigen::Vector3d& q) { return camera.Project(q); }, p);
   EXPECT_LT((camera.ProjectJacobian(p) - numeric).norm(), 1e-6);
 }
 

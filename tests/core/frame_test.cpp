@@ -1,8 +1,8 @@
 // Frame construction and validation.
 
-#include <gtest/gtest.h>
-
 #include "core/frame.hpp"
+
+#include <gtest/gtest.h>
 
 namespace parallax {
 namespace {

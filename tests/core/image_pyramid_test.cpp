@@ -1,10 +1,10 @@
 // Image pyramid: level sizes, the pixel-centre convention, gradients, pixel selection.
 
+#include "core/image_pyramid.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "core/image_pyramid.hpp"
 
 namespace parallax {
 namespace {
@@ -114,7 +114,8 @@ TEST(SemiDenseSelection, SelectsBothSidesOfAnEdgeAndNothingOnFlat) {
     EXPECT_LT(y, 28);
   }
   EXPECT_EQ(selected.size(), 4u * 26u);
-  EXPECT_TRUE(SelectSemiDensePixels(ImagePyramid(ImageU8(40, 30, 80), {1, 16}).Level(0), 1.0f).empty());
+  EXPECT_TRUE(
+      SelectSemiDensePixels(ImagePyramid(ImageU8(40, 30, 80), {1, 16}).Level(0), 1.0f).empty());
 }
 
 TEST(SemiDenseSelection, MaxGradientIsMaximumOverNeighbourhood) {
@@ -137,7 +138,8 @@ TEST(SemiDenseSelection, MaxGradientIsMaximumOverNeighbourhood) {
 TEST(Image, BilinearInterpolationIsExactOnRamps) {
   ImageF image(8, 8);
   for (int y = 0; y < 8; ++y) {
-    for (int x = 0; x < 8; ++x) image(x, y) = 2.0f * static_cast<float>(x) + 3.0f * static_cast<float>(y);
+    for (int x = 0; x < 8; ++x)
+      image(x, y) = 2.0f * static_cast<float>(x) + 3.0f * static_cast<float>(y);
   }
   EXPECT_NEAR(InterpolateBilinear(image, 2.25f, 4.5f), 2.0f * 2.25f + 3.0f * 4.5f, 1e-5);
   EXPECT_NEAR(InterpolateBilinear(image, 0.0f, 0.0f), 0.0f, 1e-6);

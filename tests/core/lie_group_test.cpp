@@ -31,8 +31,8 @@ typename G::Tangent RandomTangent(std::mt19937_64& rng) {
   if constexpr (G::kDoF == 3) {
     xi = xi.normalized() * std::uniform_real_distribution<double>(0.0, 3.0)(rng);
   } else {
-    xi.template segment<3>(3) =
-        xi.template segment<3>(3).normalized() * std::uniform_real_distribution<double>(0.0, 3.0)(rng);
+    xi.template segment<3>(3) = xi.template segment<3>(3).normalized() *
+                                std::uniform_real_distribution<double>(0.0, 3.0)(rng);
     if constexpr (G::kDoF == 7) xi[6] *= 0.5;
   }
   return xi.template cast<Scalar>();
@@ -79,7 +79,8 @@ TYPED_TEST(LieGroupTest, ExpLogRoundTripRandom) {
 TYPED_TEST(LieGroupTest, ExpLogRoundTripNearZero) {
   for (const double scale : {0.0, 1e-12, 1e-9, 1e-6, 1e-4, 1e-2}) {
     auto xi = RandomTangent<TypeParam>(this->rng_);
-    xi = (xi.template cast<double>().normalized() * scale).template cast<typename TypeParam::Tangent::Scalar>();
+    xi = (xi.template cast<double>().normalized() * scale)
+             .template cast<typename TypeParam::Tangent::Scalar>();
     const auto g = TypeParam::Exp(xi);
     EXPECT_LT((g.Log() - xi).norm(), Tolerance<TypeParam>() * 1e-2 + 1e-15) << "scale " << scale;
     // First-order agreement with the Lie algebra: Exp(xi) ~= I + hat(xi).
@@ -175,7 +176,8 @@ TYPED_TEST(LieGroupTest, LongCompositionStaysOnManifold) {
 
 TYPED_TEST(LieGroupTest, CastPreservesElement) {
   const auto g = TypeParam::Exp(RandomTangent<TypeParam>(this->rng_));
-  const auto round_trip = g.template Cast<double>().template Cast<typename TypeParam::Tangent::Scalar>();
+  const auto round_trip =
+      g.template Cast<double>().template Cast<typename TypeParam::Tangent::Scalar>();
   EXPECT_TRUE(AsMatrix(round_trip).isApprox(AsMatrix(g), Tolerance<TypeParam>()));
 }
 

@@ -1,12 +1,13 @@
 // Sim(3)-specific tests: the W coefficients, scale handling, invalid input.
 
+#include "core/sim3.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "core/lie_coefficients.hpp"
-#include "core/sim3.hpp"
 #include "tests/core/lie_test_utils.hpp"
 
 namespace parallax {

@@ -1,11 +1,12 @@
 // SO(3)- and SE(3)-specific tests: Jacobians of the exponential, invalid input, known values.
 
+#include "core/so3.hpp"
+
 #include <gtest/gtest.h>
 
 #include <numbers>
 
 #include "core/se3.hpp"
-#include "core/so3.hpp"
 #include "tests/core/lie_test_utils.hpp"
 
 namespace parallax {
@@ -28,7 +29,9 @@ TEST(SO3, LeftJacobianMatchesNumeric) {
     const Eigen::Vector3d omega = RandomVector<3>(rng, 1.0).normalized() * angle;
     const SO3d R_inv = SO3d::Exp(omega).Inverse();
     const Eigen::Matrix3d numeric = NumericJacobian<3, 3>(
-        [&](const Eigen::Vector3d& d) { return Eigen::Vector3d((SO3d::Exp(omega + d) * R_inv).Log()); },
+        [&](const Eigen::Vector3d& d) {
+          return Eigen::Vector3d((SO3d::Exp(omega + d) * R_inv).Log());
+        },
         Eigen::Vector3d::Zero());
     EXPECT_LT((SO3d::LeftJacobian(omega) - numeric).norm(), 1e-8) << "angle " << angle;
     EXPECT_TRUE((SO3d::LeftJacobianInverse(omega) * SO3d::LeftJacobian(omega))

@@ -1,10 +1,10 @@
 // Undistorter: modes, identity, and undistort -> distort consistency on a rendered image.
 
+#include "core/undistorter.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "core/undistorter.hpp"
 
 namespace parallax {
 namespace {
@@ -37,7 +37,8 @@ TEST(Undistorter, PinholeInputIsIdentity) {
   const Undistorter undistorter(camera, UndistorterOptions{});
   EXPECT_TRUE(undistorter.IsIdentity());
   ImageU8 image(64, 48);
-  for (std::size_t i = 0; i < image.NumPixels(); ++i) image.Data()[i] = static_cast<std::uint8_t>(i);
+  for (std::size_t i = 0; i < image.NumPixels(); ++i)
+    image.Data()[i] = static_cast<std::uint8_t>(i);
   const ImageU8 out = undistorter.Apply(image);
   EXPECT_TRUE(std::equal(out.Data(), out.Data() + out.NumPixels(), image.Data()));
 }
@@ -78,9 +79,9 @@ TEST(Undistorter, FullModeKeepsWholeInputInView) {
   options.mode = UndistortMode::kFull;
   const Undistorter undistorter(camera, options);
   const PinholeCamera& K = undistorter.OutputCamera();
-  for (const Eigen::Vector2d& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(639, 0),
-                                       Eigen::Vector2d(0, 479), Eigen::Vector2d(639, 479),
-                                       Eigen::Vector2d(320, 0), Eigen::Vector2d(0, 240)}) {
+  for (const Eigen::Vector2d& corner :
+       {Eigen::Vector2d(0, 0), Eigen::Vector2d(639, 0), Eigen::Vector2d(0, 479),
+        Eigen::Vector2d(639, 479), Eigen::Vector2d(320, 0), Eigen::Vector2d(0, 240)}) {
     const auto ray = camera.Unproject(corner);
     ASSERT_TRUE(ray.has_value());
     EXPECT_TRUE(K.IsInside(K.Project(*ray), -1e-6)) << corner.transpose();
