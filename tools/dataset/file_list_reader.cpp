@@ -1,0 +1,75 @@
+#include "tools/dataset/file_list_reader.hpp"
+
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+
+#include "tools/dataset/input_error.hpp"
+
+namespace parallax {
+
+void CheckTimestampsIncrease(const std::vector<ImageEntry>& entries) {
+  for (std::size_t i = 1; i < entries.size(); ++i) {
+    if (!(entries[i].timestamp > entries[i - 1].timestamp)) {
+      throw InputError(entries[i].list_file, entries[i].list_line,
+                       "timestamps must increase (" + FormatTimestamp(entries[i].timestamp) +
+                           " follows " + FormatTimestamp(entries[i - 1].timestamp) + ")");
+    }
+  }
+}
+
+ImageU8 ReadGreyImage(const std::string& path, int expected_width, int expected_height) {
+  if (!std::filesystem::exists(path)) throw InputError(path, "image file does not exist");
+  const cv::Mat grey = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (grey.empty()) throw InputError(path, "unreadable or corrupt image");
+  if (grey.cols != expected_width || grey.rows != expected_height) {
+    throw InputError(path, "image is " + std::to_string(grey.cols) + "x" +
+                               std::to_string(grey.rows) + " but the camera is " +
+                               std::to_string(expected_width) + "x" +
+                               std::to_string(expected_height));
+  }
+  ImageU8 image(grey.cols, grey.rows);
+  for (int y = 0; y < grey.rows; ++y) {
+    std::copy(grey.ptr<std::uint8_t>(y), grey.ptr<std::uint8_t>(y) + grey.cols, image.Row(y));
+  }
+  return image;
+}
+
+std::pair<int, int> ProbeImageSize(const std::string& path) {
+  if (!std::filesystem::exists(path)) throw InputError(path, "image file does not exist");
+  const cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (image.empty()) throw InputError(path, "unreadable or corrupt image");
+  return {image.cols, image.rows};
+}
+
+FileListReader::FileListReader(FileListSpec spec) : spec_(std::move(spec)) {
+  if (!spec_.camera) throw std::logic_error("FileListReader: the opener set no camera");
+  CheckTimestampsIncrease(spec_.entries);
+}
+
+std::optional<DatasetFrame> FileListReader::Next() {
+  if (next_ >= spec_.entries.size()) return std::nullopt;
+  const ImageEntry& entry = spec_.entries[next_];
+  DatasetFrame frame;
+  frame.index = next_++;
+  frame.timestamp = entry.timestamp;
+  frame.exposure_ms = entry.exposure_ms;
+  frame.source = entry.path;
+  frame.image = ReadGreyImage(entry.path, spec_.camera->Width(), spec_.camera->Height());
+  return frame;
+}
+
+std::optional<Trajectory> FileListReader::GroundTruth() const {
+  if (!spec_.groundtruth) return std::nullopt;
+  return spec_.groundtruth();
+}
+
+std::string FindCalibrationFile(const std::string& folder, const std::string& explicit_file) {
+  if (!explicit_file.empty()) return explicit_file;
+  for (const char* name : {"calibration.yaml", "camera.yaml"}) {
+    const auto candidate = std::filesystem::path(folder) / name;
+    if (std::filesystem::exists(candidate)) return candidate.string();
+  }
+  return {};
+}
+
+}  // namespace parallax

@@ -1,0 +1,74 @@
+#pragma once
+// Trajectory accuracy metrics: ATE, RPE and KITTI segment errors
+// (definitions: docs/evaluation.md).
+
+#include <string>
+#include <vector>
+
+#include "tools/dataset/trajectory.hpp"
+#include "tools/eval/alignment.hpp"
+
+namespace parallax {
+
+struct EvaluationOptions {
+  AlignmentMode alignment = AlignmentMode::kSim3;
+  /// Association window, seconds (TUM tools' default 0.02).
+  double max_dt = 0.02;
+  /// Time step of the per-second RPE, seconds.
+  double rpe_delta_seconds = 1.0;
+
+  /// Throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+/// Summary of a set of non-negative errors. All zero when count == 0.
+struct ErrorStatistics {
+  std::size_t count = 0;
+  double rmse = 0.0;
+  double mean = 0.0;
+  double median = 0.0;
+  double max = 0.0;
+};
+ErrorStatistics ComputeStatistics(std::vector<double> errors);
+
+struct RelativePoseError {
+  ErrorStatistics translation;  ///< trajectory units (metres for ground truth in metres)
+  ErrorStatistics rotation_deg;
+};
+
+/// Average of KITTI's drift over one segment length (e.g. 100 m).
+struct KittiSegmentError {
+  double length = 0.0;
+  std::size_t segments = 0;
+  double translation_percent = 0.0;    ///< mean |t_err| / length * 100
+  double rotation_deg_per_100m = 0.0;  ///< mean angle / length * 100, degrees
+};
+
+struct EvaluationReport {
+  AlignmentMode alignment = AlignmentMode::kSim3;
+  std::size_t estimate_poses = 0;
+  std::size_t groundtruth_poses = 0;
+  std::size_t matched = 0;
+  /// Ground-truth poses whose time lies inside the estimate's [first, last] span.
+  std::size_t groundtruth_in_span = 0;
+  double coverage = 0.0;                 ///< matched / groundtruth_in_span
+  Sim3d S_gt_est;                        ///< alignment applied to the estimate
+  ErrorStatistics ate;                   ///< absolute trajectory error of positions after alignment
+  double groundtruth_path_length = 0.0;  ///< along the matched ground-truth poses
+  double ate_rmse_percent_of_path = 0.0;
+  RelativePoseError rpe_per_frame;       ///< consecutive matched poses
+  RelativePoseError rpe_per_second;      ///< pairs rpe_delta_seconds apart
+  std::vector<KittiSegmentError> kitti;  ///< lengths 100..800 m that fit in the path
+};
+
+/// Associates, aligns and measures. Throws std::invalid_argument when fewer than 3 poses
+/// associate (naming max_dt) or the alignment is degenerate.
+EvaluationReport Evaluate(const Trajectory& estimate, const Trajectory& groundtruth,
+                          const EvaluationOptions& options);
+
+/// Compact human-readable table.
+std::string FormatReport(const EvaluationReport& report);
+/// Machine-readable JSON (keys documented in docs/evaluation.md).
+std::string ReportToJson(const EvaluationReport& report);
+
+}  // namespace parallax
