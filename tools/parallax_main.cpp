@@ -4,22 +4,19 @@
 #include <cstdio>
 #include <exception>
 
-namespace {
+#include "tools/commands/commands.hpp"
 
-int RunDemo() {
-  std::fprintf(stderr,
-               "parallax demo: the visual-odometry pipeline is not implemented yet; this build "
-               "provides the core library (geometry, cameras, pyramids) only.\n");
-  return 2;
-}
+namespace {
 
 int Run(int argc, char** argv) {
   CLI::App app{"Parallax: direct semi-dense monocular SLAM"};
   app.require_subcommand(1);
   app.set_version_flag("--version", PARALLAX_VERSION);
-  CLI::App* demo = app.add_subcommand("demo", "Run the pipeline on a built-in synthetic sequence");
   int exit_code = 0;
-  demo->callback([&] { exit_code = RunDemo(); });
+  parallax::cli::AddDemoCommand(app, &exit_code);
+  parallax::cli::AddEvalCommand(app, &exit_code);
+  parallax::cli::AddInfoCommand(app, &exit_code);
+  parallax::cli::AddSynthCommand(app, &exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,161 @@
+#include "tools/synth/synthetic_sequence.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <opencv2/imgcodecs.hpp>
+
+#include "core/check.hpp"
+#include "tools/dataset/calibration_yaml.hpp"
+#include "tools/dataset/input_error.hpp"
+#include "tools/dataset/trajectory.hpp"
+#include "tools/synth/random.hpp"
+#include "tools/synth/renderer.hpp"
+
+namespace fs = std::filesystem;
+
+namespace parallax::synth {
+namespace {
+
+double Duration(const SynthOptions& o) { return (o.frames - 1) / o.fps; }
+
+// Smooth auto-exposure-like gain, between about 0.64 and 1.57.
+float ExposureGain(double t) {
+  return static_cast<float>(std::exp(0.25 * std::sin(2.0 * std::numbers::pi * t / 3.0) +
+                                     0.2 * std::sin(2.0 * std::numbers::pi * t / 1.3 + 1.0)));
+}
+
+float Vignette(int x, int y, int w, int h) {
+  const double dx = (x - 0.5 * (w - 1)) / (0.5 * w), dy = (y - 0.5 * (h - 1)) / (0.5 * w);
+  const double r2 = (dx * dx + dy * dy) / (1.0 + static_cast<double>(h * h) / (w * w));
+  return static_cast<float>(1.0 - 0.3 * r2 - 0.15 * r2 * r2);
+}
+
+void WriteLines(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  if (!out) throw InputError(path, "cannot open for writing");
+  out << text;
+  if (!out) throw InputError(path, "write failed");
+}
+
+void WritePng(const std::string& path, const cv::Mat& image) {
+  if (!cv::imwrite(path, image, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
+    throw InputError(path, "cannot write image");
+  }
+}
+
+}  // namespace
+
+void SynthOptions::Check() const {
+  CheckOption(frames >= 2, "SynthOptions", "frames", "must be >= 2");
+  CheckOption(width >= 32 && height >= 32, "SynthOptions", "width/height", "must be >= 32");
+  CheckOption(std::isfinite(fps) && fps > 0.0, "SynthOptions", "fps", "must be > 0");
+  CheckOption(std::isfinite(noise_sigma) && noise_sigma >= 0.0, "SynthOptions", "noise_sigma",
+              "must be >= 0");
+  MotionFromString(motion);
+}
+
+PinholeCamera SynthCamera(const SynthOptions& o) {
+  const double f = 525.0 * o.width / 640.0;
+  return PinholeCamera(o.width, o.height, f, f, 0.5 * (o.width - 1), 0.5 * (o.height - 1));
+}
+
+double FrameTimestamp(const SynthOptions& o, int index) {
+  return std::round(index / o.fps * 1e6) / 1e6;
+}
+
+SE3d FramePose(const SynthOptions& o, const Scene& scene, int index) {
+  return CameraPose(MotionFromString(o.motion), scene.rig, FrameTimestamp(o, index), Duration(o));
+}
+
+SynthFrame RenderSynthFrame(const SynthOptions& o, const Scene& scene, int index) {
+  const PinholeCamera camera = SynthCamera(o);
+  const Motion motion = MotionFromString(o.motion);
+  const double t = FrameTimestamp(o, index);
+  RenderedView view = Render(scene, camera, CameraPose(motion, scene.rig, t, Duration(o)));
+  if (o.blur) {
+    // Average sub-frames over the 40% of the frame interval before t (shutter open).
+    constexpr int kSubFrames = 5;
+    for (int k = 1; k < kSubFrames; ++k) {
+      const double ts = t - 0.4 / o.fps * k / (kSubFrames - 1);
+      const RenderedView sub =
+          Render(scene, camera, CameraPose(motion, scene.rig, std::max(ts, 0.0), Duration(o)));
+      for (std::size_t i = 0; i < view.intensity.NumPixels(); ++i)
+        view.intensity.Data()[i] += sub.intensity.Data()[i];
+    }
+    for (std::size_t i = 0; i < view.intensity.NumPixels(); ++i)
+      view.intensity.Data()[i] /= kSubFrames;
+  }
+  SynthFrame frame{ImageU8(o.width, o.height), std::move(view.depth),
+                   o.exposure ? ExposureGain(t) : 1.0f};
+  const std::uint64_t noise_seed = o.seed * std::uint64_t{1000003} + static_cast<unsigned>(index);
+  Random noise(noise_seed);
+  for (int y = 0; y < o.height; ++y) {
+    for (int x = 0; x < o.width; ++x) {
+      float value = view.intensity(x, y) * frame.gain;
+      if (o.vignette) value *= Vignette(x, y, o.width, o.height);
+      if (o.noise_sigma > 0.0) value += static_cast<float>(o.noise_sigma * noise.Normal());
+      frame.image(x, y) = static_cast<std::uint8_t>(std::lround(std::clamp(value, 0.0f, 255.0f)));
+    }
+  }
+  return frame;
+}
+
+SynthSummary WriteSyntheticSequence(const SynthOptions& o, const std::string& out_dir) {
+  o.Check();
+  const Scene scene = MakeScene(o.scene, o.seed, o.textures);
+  std::error_code ec;
+  fs::create_directories(fs::path(out_dir) / "rgb", ec);
+  fs::create_directories(fs::path(out_dir) / "depth", ec);
+  if (ec || !fs::is_directory(fs::path(out_dir) / "rgb")) {
+    throw InputError(out_dir, "cannot create output folders: " + ec.message());
+  }
+  const std::string header = fmt::format("# parallax synth: scene {} motion {} seed {} frames {}\n",
+                                         o.scene, o.motion, o.seed, o.frames);
+  std::string rgb_list = header + "# timestamp filename\n";
+  std::string depth_list = header + "# timestamp filename (16-bit, 5000 units = 1 m, 0 = none)\n";
+  Trajectory groundtruth;
+  SynthSummary summary;
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < o.frames; ++i) {
+    const double t = FrameTimestamp(o, i);
+    const std::string stamp = fmt::format("{:.6f}", t);
+    const SynthFrame frame = RenderSynthFrame(o, scene, i);
+    WritePng((fs::path(out_dir) / "rgb" / (stamp + ".png")).string(),
+             cv::Mat(o.height, o.width, CV_8UC1, const_cast<std::uint8_t*>(frame.image.Data())));
+    cv::Mat depth(o.height, o.width, CV_16UC1);
+    for (int y = 0; y < o.height; ++y) {
+      for (int x = 0; x < o.width; ++x) {
+        const double units = std::round(frame.depth(x, y) * 5000.0);
+        depth.at<std::uint16_t>(y, x) =
+            units > 0.0 && units <= 65535.0 ? static_cast<std::uint16_t>(units) : 0;
+      }
+    }
+    WritePng((fs::path(out_dir) / "depth" / (stamp + ".png")).string(), depth);
+    rgb_list += fmt::format("{} rgb/{}.png\n", stamp, stamp);
+    depth_list += fmt::format("{} depth/{}.png\n", stamp, stamp);
+    groundtruth.push_back({t, FramePose(o, scene, i)});
+    if (i > 0) {
+      summary.path_length += (groundtruth[static_cast<std::size_t>(i)].T_w_c.Translation() -
+                              groundtruth[static_cast<std::size_t>(i - 1)].T_w_c.Translation())
+                                 .norm();
+    }
+  }
+  summary.render_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.frames = o.frames;
+  WriteLines((fs::path(out_dir) / "rgb.txt").string(), rgb_list);
+  WriteLines((fs::path(out_dir) / "depth.txt").string(), depth_list);
+  WriteTumTrajectory((fs::path(out_dir) / "groundtruth.txt").string(), groundtruth);
+  const PinholeCamera K = SynthCamera(o);
+  WriteCalibrationYaml(
+      (fs::path(out_dir) / "calibration.yaml").string(),
+      Camera(CameraModel::kPinhole, K.Width(), K.Height(), K.Fx(), K.Fy(), K.Cx(), K.Cy()), o.fps);
+  return summary;
+}
+
+}  // namespace parallax::synth
