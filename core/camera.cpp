@@ -215,7 +215,8 @@ std::optional<Eigen::Vector2d> Camera::Undistort(const Eigen::Vector2d& x_d) con
 }
 
 std::string Camera::ToString() const {
-  std::string s = parallax::ToString(model_) + " " + intrinsics_.ToString();
+  // PinholeCamera::ToString starts with "pinhole "; replace that with the real model.
+  std::string s = parallax::ToString(model_) + intrinsics_.ToString().substr(7);
   for (const double d : distortion_) s += " " + std::to_string(d);
   return s;
 }

@@ -177,20 +177,27 @@ Texture Texture::FromFile(const std::string& path) {
 }
 
 float Texture::SampleLevel(int level, float u, float v) const {
+  // Precondition u, v >= 0 (quad texture coordinates and offsets are non-negative), so
+  // truncation is floor; adding n keeps x, y positive after the half-texel shift.
   const ImageF& image = levels_[static_cast<std::size_t>(level)];
   const int n = image.Width();
-  const float x = (u - std::floor(u)) * static_cast<float>(n) - 0.5f;
-  const float y = (v - std::floor(v)) * static_cast<float>(n) - 0.5f;
-  const float xf = std::floor(x), yf = std::floor(y);
-  const float ax = x - xf, ay = y - yf;
-  const int x0 = (static_cast<int>(xf) + n) & (n - 1), y0 = (static_cast<int>(yf) + n) & (n - 1);
-  const int x1 = (x0 + 1) & (n - 1), y1 = (y0 + 1) & (n - 1);
-  return (1 - ay) * ((1 - ax) * image(x0, y0) + ax * image(x1, y0)) +
-         ay * ((1 - ax) * image(x0, y1) + ax * image(x1, y1));
+  const int mask = n - 1;
+  const float x = u * static_cast<float>(n) - 0.5f + static_cast<float>(n);
+  const float y = v * static_cast<float>(n) - 0.5f + static_cast<float>(n);
+  const int xi = static_cast<int>(x), yi = static_cast<int>(y);
+  const float ax = x - static_cast<float>(xi), ay = y - static_cast<float>(yi);
+  const int x0 = xi & mask, y0 = yi & mask, x1 = (xi + 1) & mask, y1 = (yi + 1) & mask;
+  const float* r0 = image.Row(y0);
+  const float* r1 = image.Row(y1);
+  return (1 - ay) * ((1 - ax) * r0[x0] + ax * r0[x1]) + ay * ((1 - ax) * r1[x0] + ax * r1[x1]);
 }
 
 float Texture::Sample(float u, float v, float texels) const {
-  const float lod = std::log2(std::max(texels, 1.0f));
+  // Level of detail log2(texels), linear in the mantissa: continuous and monotonic, which is
+  // all trilinear blending needs, and much cheaper than log2f.
+  int exponent = 0;
+  const float mantissa = std::frexp(std::max(texels, 1.0f), &exponent);  // in [0.5, 1)
+  const float lod = static_cast<float>(exponent - 1) + (2.0f * mantissa - 1.0f);
   const int max_level = NumLevels() - 1;
   const int l0 = std::min(static_cast<int>(lod), max_level);
   const float t = std::min(lod - static_cast<float>(l0), 1.0f);

@@ -31,7 +31,7 @@ class Texture {
 
   int Size() const { return levels_.front().Width(); }
   int NumLevels() const { return static_cast<int>(levels_.size()); }
-  /// Trilinear sample at texture coordinates (u, v) in tiles (1.0 = one texture width;
+  /// Trilinear sample at texture coordinates (u, v) >= 0 in tiles (1.0 = one texture width;
   /// wraps), with a footprint of `texels` level-0 texels per screen pixel.
   float Sample(float u, float v, float texels) const;
 
