@@ -1,0 +1,42 @@
+#pragma once
+// Gauss-Newton normal equations H dx = -g accumulated from weighted residuals, reducible so
+// that partial sums over blocks of points can be added in a fixed order (deterministic).
+
+#include <Eigen/Core>
+
+namespace parallax {
+
+/// Accumulates H = sum w J J^T, g = sum w J r and the robust cost for N parameters.
+/// Per-residual terms are float (the hot loop), sums are double so that tens of thousands of
+/// terms do not lose precision.
+template <int N>
+struct NormalEquations {
+  Eigen::Matrix<double, N, N> H = Eigen::Matrix<double, N, N>::Zero();
+  Eigen::Matrix<double, N, 1> g = Eigen::Matrix<double, N, 1>::Zero();
+  double cost = 0.0;  ///< sum of robust costs
+  int count = 0;      ///< residuals added
+
+  /// Adds one residual r with Jacobian J (1xN as a column), weight w and robust cost.
+  void Add(const Eigen::Matrix<float, N, 1>& J, float r, float w, float robust_cost) {
+    const Eigen::Matrix<double, N, 1> Jd = J.template cast<double>();
+    H.template selfadjointView<Eigen::Upper>().rankUpdate(Jd, static_cast<double>(w));
+    g.noalias() += (static_cast<double>(w) * static_cast<double>(r)) * Jd;
+    cost += static_cast<double>(robust_cost);
+    ++count;
+  }
+
+  NormalEquations& operator+=(const NormalEquations& other) {
+    H += other.H;
+    g += other.g;
+    cost += other.cost;
+    count += other.count;
+    return *this;
+  }
+
+  /// H with its lower triangle filled from the upper one (Add only writes the upper).
+  Eigen::Matrix<double, N, N> SymmetricH() const {
+    return H.template selfadjointView<Eigen::Upper>();
+  }
+};
+
+}  // namespace parallax

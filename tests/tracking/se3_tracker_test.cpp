@@ -1,0 +1,240 @@
+// SE(3) tracker: Jacobians against numeric differentiation, convergence on renders with exact
+// depth, the affine brightness model, lost detection, determinism.
+
+#include "tracking/se3_tracker.hpp"
+
+#include <gtest/gtest.h>
+
+#include "tests/tracking/render_fixture.hpp"
+#include "tracking/photometric_residual.hpp"
+
+namespace parallax {
+namespace {
+
+using test::ComparePoses;
+using test::RenderedKeyframe;
+
+// --- Jacobians -------------------------------------------------------------------------
+
+// Float planes of an analytic image, so that the kernel's gradient lookups are exact:
+// I = c + ax x + ay y + q ((x - 300)^2 + (y - 200)^2). Central differences of a quadratic
+// are exact at pixel centres and bilinear interpolation of the (linear) gradient is exact.
+struct AnalyticLevel {
+  ImageF intensity{640, 480}, dx{640, 480}, dy{640, 480}, grad_sq{640, 480};
+  PyramidLevel level;
+  explicit AnalyticLevel(double q) {
+    for (int y = 0; y < 480; ++y) {
+      for (int x = 0; x < 640; ++x) {
+        const double ex = x - 300.0, ey = y - 200.0;
+        intensity(x, y) = static_cast<float>(20.0 + 0.3 * x + 0.2 * y + q * (ex * ex + ey * ey));
+        dx(x, y) = static_cast<float>(0.3 + 2.0 * q * ex);
+        dy(x, y) = static_cast<float>(0.2 + 2.0 * q * ey);
+        grad_sq(x, y) = dx(x, y) * dx(x, y) + dy(x, y) * dy(x, y);
+      }
+    }
+    level = PyramidLevel{intensity, dx, dy, grad_sq};
+  }
+};
+
+struct KernelInput {
+  Eigen::Matrix3f M;
+  Eigen::Vector3f t;
+  float ray_x = 0.05f, ray_y = -0.08f, idepth = 0.4f, intensity = 90.0f, gain = 1.3f, offset = 4.0f;
+};
+
+double Residual(const PyramidLevel& level, const LevelCamera& cam, const KernelInput& in) {
+  PhotometricTerm term;
+  EXPECT_TRUE(EvaluatePhotometric(level, cam, in.M, in.t, in.ray_x, in.ray_y, in.idepth, 0.0f,
+                                  in.intensity, in.gain, in.offset, 16.0f, &term));
+  return term.residual;
+}
+
+KernelInput WithPose(KernelInput in, const SE3d& T) {
+  in.M = T.RotationMatrix().cast<float>();
+  in.t = T.Translation().cast<float>();
+  return in;
+}
+
+class PhotometricJacobianTest : public ::testing::TestWithParam<double> {};
+
+TEST_P(PhotometricJacobianTest, MatchesNumericDifferentiation) {
+  const AnalyticLevel image(GetParam());
+  const LevelCamera cam{525.0f, 525.0f, 319.5f, 239.5f, 638.0f, 478.0f};
+  const SE3d T =
+      SE3d::Exp((Eigen::Matrix<double, 6, 1>() << 0.1, -0.05, 0.2, 0.02, -0.03, 0.01).finished());
+  const KernelInput in = WithPose(KernelInput{}, T);
+  PhotometricTerm term;
+  ASSERT_TRUE(EvaluatePhotometric(image.level, cam, in.M, in.t, in.ray_x, in.ray_y, in.idepth,
+                                  0.01f, in.intensity, in.gain, in.offset, 16.0f, &term));
+  Eigen::Matrix<double, 6, 1> J_analytic;
+  J_analytic.head<3>() = term.dr_dp.cast<double>();
+  J_analytic.tail<3>() = term.p.cross(term.dr_dp).cast<double>();
+  ASSERT_GT(J_analytic.norm(), 10.0);  // not trivially zero
+  const double h = 1e-3;
+  for (int k = 0; k < 6; ++k) {
+    Eigen::Matrix<double, 6, 1> d = Eigen::Matrix<double, 6, 1>::Zero();
+    d[k] = h;
+    const double numeric = (Residual(image.level, cam, WithPose(in, SE3d::Exp(d) * T)) -
+                            Residual(image.level, cam, WithPose(in, SE3d::Exp(-d) * T))) /
+                           (2 * h);
+    EXPECT_NEAR(J_analytic[k], numeric, 0.01 * std::abs(numeric) + 0.05) << "pose parameter " << k;
+  }
+  // Affine terms: r = I - exp(a) I_ref - b, so dr/da = -exp(a) I_ref and dr/db = -1.
+  KernelInput brighter = in;
+  brighter.gain = in.gain * std::exp(1e-3f);
+  EXPECT_NEAR((Residual(image.level, cam, brighter) - Residual(image.level, cam, in)) / 1e-3,
+              -in.gain * in.intensity, 0.2);
+  KernelInput shifted = in;
+  shifted.offset += 0.5f;
+  EXPECT_NEAR(Residual(image.level, cam, shifted) - Residual(image.level, cam, in), -0.5, 1e-4);
+  // d r / d idepth enters the variance: variance - sigma_I^2 = (dr/dd)^2 var(idepth).
+  KernelInput nearer = in, farther = in;
+  nearer.idepth += 1e-3f;
+  farther.idepth -= 1e-3f;
+  const double dr_dd =
+      (Residual(image.level, cam, nearer) - Residual(image.level, cam, farther)) / 2e-3;
+  ASSERT_GT(std::abs(dr_dd), 1.0);
+  EXPECT_NEAR(term.variance - 16.0, dr_dd * dr_dd * 0.01, 0.02 * dr_dd * dr_dd * 0.01);
+}
+
+INSTANTIATE_TEST_SUITE_P(RampAndQuadratic, PhotometricJacobianTest, ::testing::Values(0.0, 2e-4));
+
+// --- Convergence on renders ------------------------------------------------------------
+
+class Se3TrackerRenderTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    scene_ = std::make_unique<synth::Scene>(synth::MakeScene("room", 3));
+    options_.scene = "room";
+    options_.motion = "shake";
+    options_.frames = 40;
+    keyframe_ = std::make_unique<RenderedKeyframe>(test::RenderTestKeyframe(*scene_, Pose(0)));
+  }
+  static void TearDownTestSuite() {
+    keyframe_.reset();
+    scene_.reset();
+  }
+  static SE3d Pose(int i) { return synth::FramePose(options_, *scene_, i); }
+  static SE3d TrueKfFrame(int i) { return keyframe_->T_w_c.Inverse() * Pose(i); }
+  // Perturbation: `degrees` about a fixed axis, translation `fraction` of the scene depth.
+  static SE3d Perturb(const SE3d& T, double degrees, double fraction, int variant) {
+    const Eigen::Vector3d axes[] = {{1, 0.3, -0.2}, {-0.4, 1, 0.5}, {0.2, -0.6, 1}, {1, 1, 1}};
+    const Eigen::Vector3d dirs[] = {{0.2, 1, 0.4}, {1, -0.2, 0.1}, {-0.5, 0.3, 1}, {0.6, -1, -0.3}};
+    Eigen::Matrix<double, 6, 1> xi;
+    xi << dirs[variant].normalized() * fraction * keyframe_->mean_depth,
+        axes[variant].normalized() * degrees * 3.14159265358979 / 180.0;
+    return T * SE3d::Exp(xi);
+  }
+
+  static inline std::unique_ptr<synth::Scene> scene_;
+  static inline synth::SynthOptions options_;
+  static inline std::unique_ptr<RenderedKeyframe> keyframe_;
+};
+
+TEST_F(Se3TrackerRenderTest, ConvergesFromLargeInitialErrorNoiseFree) {
+  const TrackingReference reference(keyframe_->frame, keyframe_->idepth, keyframe_->variance);
+  ASSERT_GT(reference.Level(0).Size(), 20000u);
+  const auto frame = test::RenderTestFrame(*scene_, Pose(10), 1);
+  Se3Tracker tracker;
+  for (int variant = 0; variant < 4; ++variant) {
+    const SE3d guess = Perturb(TrueKfFrame(10), 3.0, 0.05, variant);
+    const TrackingResult result = tracker.TrackFrom(reference, *frame, guess, {});
+    const auto error = ComparePoses(result.T_kf_frame, TrueKfFrame(10));
+    EXPECT_EQ(result.status, TrackingStatus::kOk) << result.stats.reason;
+    EXPECT_LT(error.rotation_deg, 0.05) << "variant " << variant;
+    EXPECT_LT(error.translation, 0.001 * keyframe_->mean_depth) << "variant " << variant;
+    // Views at other distances sample other mip levels (slightly less contrast), so the
+    // fitted gain is not exactly 1 even without an exposure change.
+    EXPECT_NEAR(result.affine.a, 0.0, 0.03);
+  }
+}
+
+TEST_F(Se3TrackerRenderTest, AffineModelHandlesExposureChangeWithNoise) {
+  const TrackingReference reference(keyframe_->frame, keyframe_->idepth, keyframe_->variance);
+  const auto frame = test::RenderTestFrame(*scene_, Pose(10), 1, 1.6f, 2.0, 7);
+  Se3Tracker with_affine;
+  Se3TrackerOptions no_affine_options;
+  no_affine_options.estimate_affine = false;
+  Se3Tracker without_affine(no_affine_options);
+  for (int variant = 0; variant < 2; ++variant) {
+    const SE3d guess = Perturb(TrueKfFrame(10), 3.0, 0.05, variant);
+    const TrackingResult good = with_affine.TrackFrom(reference, *frame, guess, {});
+    const auto error = ComparePoses(good.T_kf_frame, TrueKfFrame(10));
+    EXPECT_EQ(good.status, TrackingStatus::kOk) << good.stats.reason;
+    EXPECT_LT(error.rotation_deg, 0.2);
+    EXPECT_LT(error.translation, 0.005 * keyframe_->mean_depth);
+    // x1.6 saturates the brightest pixels at 255, which pulls the fitted gain down a little.
+    EXPECT_NEAR(good.affine.Gain(), 1.6, 0.1);
+    // Without the brightness model the same problem fails: large error or not ok.
+    const TrackingResult bad = without_affine.TrackFrom(reference, *frame, guess, {});
+    const auto bad_error = ComparePoses(bad.T_kf_frame, TrueKfFrame(10));
+    const bool failed = bad.status != TrackingStatus::kOk || bad_error.rotation_deg > 0.2 ||
+                        bad_error.translation > 0.005 * keyframe_->mean_depth;
+    EXPECT_TRUE(failed) << "rot " << bad_error.rotation_deg << " trans " << bad_error.translation
+                        << " status " << ToString(bad.status);
+  }
+}
+
+TEST_F(Se3TrackerRenderTest, ReportsLostOnOtherSceneAndBlackFrame) {
+  const TrackingReference reference(keyframe_->frame, keyframe_->idepth, keyframe_->variance);
+  Se3Tracker tracker;
+  const synth::Scene corridor = synth::MakeScene("corridor", 3);
+  const auto other = test::RenderTestFrame(corridor, SE3d(), 2);
+  const TrackingResult other_result = tracker.Track(reference, *other, {SE3d()});
+  EXPECT_EQ(other_result.status, TrackingStatus::kLost)
+      << "good ratio " << other_result.stats.good_ratio;
+  const auto black =
+      std::make_shared<const Frame>(3, 0.0, test::TestCamera(), ImageU8(640, 480, 0));
+  const TrackingResult black_result = tracker.Track(reference, *black, {SE3d()});
+  EXPECT_EQ(black_result.status, TrackingStatus::kLost);
+  EXPECT_FALSE(black_result.stats.reason.empty());
+}
+
+TEST_F(Se3TrackerRenderTest, HypothesesRecoverFromABadFirstGuess) {
+  const TrackingReference reference(keyframe_->frame, keyframe_->idepth, keyframe_->variance);
+  const auto frame = test::RenderTestFrame(*scene_, Pose(10), 1);
+  Se3Tracker tracker;
+  // First guess far off (12 degrees); the second hypothesis is the truth plus a small error.
+  const std::vector<SE3d> hypotheses = {Perturb(TrueKfFrame(10), 12.0, 0.3, 0),
+                                        Perturb(TrueKfFrame(10), 1.0, 0.01, 1)};
+  const TrackingResult result = tracker.Track(reference, *frame, hypotheses);
+  EXPECT_EQ(result.status, TrackingStatus::kOk);
+  EXPECT_GT(result.stats.hypotheses_tried, 1);
+  EXPECT_LT(ComparePoses(result.T_kf_frame, TrueKfFrame(10)).rotation_deg, 0.05);
+}
+
+TEST_F(Se3TrackerRenderTest, DeterministicResults) {
+  const TrackingReference reference(keyframe_->frame, keyframe_->idepth, keyframe_->variance);
+  const auto frame = test::RenderTestFrame(*scene_, Pose(6), 1, 1.2f, 3.0);
+  Se3Tracker a, b;
+  const TrackingResult ra = a.TrackFrom(reference, *frame, SE3d(), {});
+  const TrackingResult rb = b.TrackFrom(reference, *frame, SE3d(), {});
+  EXPECT_EQ(ra.T_kf_frame.Matrix(), rb.T_kf_frame.Matrix());
+  EXPECT_EQ(ra.affine.a, rb.affine.a);
+}
+
+TEST(TrackingReference, CoarseLevelsAreInverseVarianceWeighted) {
+  ImageU8 image(64, 48);
+  for (int y = 0; y < 48; ++y) {
+    for (int x = 0; x < 64; ++x) image(x, y) = static_cast<std::uint8_t>((x % 8) * 30);
+  }
+  const auto frame = std::make_shared<const Frame>(
+      0, 0.0, PinholeCamera(64, 48, 50, 50, 31.5, 23.5), image, PyramidOptions{2, 8});
+  ImageF idepth(64, 48, 0.0f), variance(64, 48, 0.0f);
+  idepth(20, 20) = 1.0f;
+  variance(20, 20) = 1.0f;
+  idepth(21, 20) = 2.0f;
+  variance(21, 20) = 3.0f;  // weight 1/3
+  TrackingReferenceOptions options;
+  options.min_gradient = 0.0f;
+  const TrackingReference reference(frame, idepth, variance, options);
+  ASSERT_EQ(reference.Level(0).Size(), 2u);
+  ASSERT_EQ(reference.Level(1).Size(), 1u);
+  EXPECT_FLOAT_EQ(reference.Level(1).idepth[0], (1.0f + 2.0f / 3.0f) / (1.0f + 1.0f / 3.0f));
+  EXPECT_FLOAT_EQ(reference.Level(1).variance[0], 1.0f / (1.0f + 1.0f / 3.0f));
+  EXPECT_EQ(reference.Level(1).u[0], 10.0f);
+  EXPECT_THROW(TrackingReference(frame, ImageF(10, 10), variance), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace parallax

@@ -1,0 +1,287 @@
+#include "tracking/se3_tracker.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+
+#include "core/check.hpp"
+#include "tracking/photometric_residual.hpp"
+
+namespace parallax {
+namespace {
+
+constexpr std::size_t kBlockSize = 2048;  // points per deterministic partial sum
+
+LevelCamera ToLevelCamera(const PinholeCamera& c) {
+  return {static_cast<float>(c.Fx()),        static_cast<float>(c.Fy()),
+          static_cast<float>(c.Cx()),        static_cast<float>(c.Cy()),
+          static_cast<float>(c.Width() - 2), static_cast<float>(c.Height() - 2)};
+}
+
+int MaxIterations(const std::vector<int>& per_level, int level) {
+  return per_level[std::min(static_cast<std::size_t>(level), per_level.size() - 1)];
+}
+
+}  // namespace
+
+std::string ToString(TrackingStatus status) {
+  switch (status) {
+    case TrackingStatus::kOk:
+      return "ok";
+    case TrackingStatus::kPoor:
+      return "poor";
+    case TrackingStatus::kLost:
+      return "lost";
+  }
+  return "lost";
+}
+
+void Se3TrackerOptions::Check() const {
+  const char* s = "Se3TrackerOptions";
+  CheckOption(finest_level >= 0 && finest_level < kMaxPyramidLevels, s, "finest_level",
+              "must be in [0, 7]");
+  CheckOption(!max_iterations.empty(), s, "max_iterations", "must not be empty");
+  for (const int n : max_iterations)
+    CheckOption(n >= 0, s, "max_iterations", "entries must be >= 0");
+  CheckOption(pixel_noise_sigma > 0.0f, s, "pixel_noise_sigma", "must be > 0");
+  CheckOption(huber_threshold > 0.0f, s, "huber_threshold", "must be > 0");
+  CheckOption(affine_prior_a >= 0.0f && affine_prior_b >= 0.0f, s, "affine_prior_a/b",
+              "must be >= 0");
+  CheckOption(max_abs_affine_a > 0.0f, s, "max_abs_affine_a", "must be > 0");
+  CheckOption(good_threshold > 0.0f, s, "good_threshold", "must be > 0");
+  CheckOption(min_good_ratio_poor <= min_good_ratio_ok, s, "min_good_ratio_poor",
+              "must be <= min_good_ratio_ok");
+  CheckOption(min_usage >= 0.0f && min_usage <= min_usage_ok, s, "min_usage",
+              "must be in [0, min_usage_ok]");
+  CheckOption(relative_cost_tolerance >= 0.0f, s, "relative_cost_tolerance", "must be >= 0");
+  CheckOption(hypothesis_iterations >= 0, s, "hypothesis_iterations", "must be >= 0");
+}
+
+Se3Tracker::Se3Tracker(const Se3TrackerOptions& options) : options_(options) { options_.Check(); }
+
+Se3Tracker::LevelEvaluation Se3Tracker::EvaluateLevel(const TrackingReference& reference,
+                                                      const Frame& frame, int level,
+                                                      const SE3d& T_frame_kf,
+                                                      const AffineBrightness& affine) {
+  const ReferenceLevel& points = reference.Level(level);
+  const PyramidLevel& image = frame.Level(level);
+  const LevelCamera camera = ToLevelCamera(frame.Camera(level));
+  const Eigen::Matrix3f R = T_frame_kf.RotationMatrix().cast<float>();
+  const Eigen::Vector3f t = T_frame_kf.Translation().cast<float>();
+  const float gain = affine.Gain(), offset = affine.b;
+  const float noise_var = options_.pixel_noise_sigma * options_.pixel_noise_sigma;
+  const float k = options_.huber_threshold,
+              good_sq = options_.good_threshold * options_.good_threshold;
+  const std::size_t num_blocks = (points.Size() + kBlockSize - 1) / kBlockSize;
+  block_sums_.assign(num_blocks, LevelEvaluation{});
+  tbb::parallel_for(std::size_t{0}, num_blocks, [&](std::size_t block) {
+    LevelEvaluation& sum = block_sums_[block];
+    const std::size_t end = std::min(points.Size(), (block + 1) * kBlockSize);
+    PhotometricTerm term;
+    for (std::size_t i = block * kBlockSize; i < end; ++i) {
+      if (!EvaluatePhotometric(image, camera, R, t, points.ray_x[i], points.ray_y[i],
+                               points.idepth[i], points.variance[i], points.intensity[i], gain,
+                               offset, noise_var, &term)) {
+        continue;
+      }
+      const RobustWeight w = HuberWeight(term.residual, term.variance, k);
+      Eigen::Matrix<float, 8, 1> J;
+      J.head<3>() = term.dr_dp;
+      J.segment<3>(3) = term.p.cross(term.dr_dp);
+      J[6] = -gain * points.intensity[i];
+      J[7] = -1.0f;
+      sum.equations.Add(J, term.residual, w.weight, w.cost);
+      ++sum.in_view;
+      sum.good += term.residual * term.residual < good_sq * term.variance;
+      sum.sum_sq_residual += static_cast<double>(term.residual) * term.residual;
+      sum.sum_gradient_sq += term.gradient_sq;
+    }
+  });
+  LevelEvaluation total;
+  for (const LevelEvaluation& block : block_sums_) {  // fixed order: deterministic
+    total.equations += block.equations;
+    total.in_view += block.in_view;
+    total.good += block.good;
+    total.sum_sq_residual += block.sum_sq_residual;
+    total.sum_gradient_sq += block.sum_gradient_sq;
+  }
+  return total;
+}
+
+double Se3Tracker::Cost(const LevelEvaluation& e, const State& s,
+                        const AffineBrightness& prior) const {
+  if (e.in_view == 0) return std::numeric_limits<double>::infinity();
+  double cost = e.equations.cost / e.in_view;
+  if (options_.estimate_affine) {
+    const double da = s.affine.a - prior.a, db = s.affine.b - prior.b;
+    cost += 0.5 * (options_.affine_prior_a * da * da + options_.affine_prior_b * db * db);
+  }
+  return cost;
+}
+
+int Se3Tracker::OptimizeLevel(const TrackingReference& reference, const Frame& frame, int level,
+                              int max_iterations, const AffineBrightness& prior, State* state) {
+  const int min_points = std::max<int>(
+      20,
+      static_cast<int>(options_.min_usage * static_cast<double>(reference.Level(level).Size())));
+  LevelEvaluation current =
+      EvaluateLevel(reference, frame, level, state->T_frame_kf, state->affine);
+  double cost = Cost(current, *state, prior);
+  double lambda = 0.0;
+  int iterations = 0;
+  for (; iterations < max_iterations; ++iterations) {
+    if (current.in_view < min_points) break;
+    // Per-point normalised normal equations plus the affine prior.
+    const double n = current.in_view;
+    Eigen::Matrix<double, 8, 8> H = current.equations.SymmetricH() / n;
+    Eigen::Matrix<double, 8, 1> g = current.equations.g / n;
+    const int dof = options_.estimate_affine ? 8 : 6;
+    if (options_.estimate_affine) {
+      H(6, 6) += options_.affine_prior_a;
+      H(7, 7) += options_.affine_prior_b;
+      g[6] += options_.affine_prior_a * (state->affine.a - prior.a);
+      g[7] += options_.affine_prior_b * (state->affine.b - prior.b);
+    }
+    Eigen::MatrixXd A = H.topLeftCorner(dof, dof);
+    A.diagonal() *= 1.0 + lambda;
+    const Eigen::VectorXd delta = A.ldlt().solve(-g.head(dof));
+    if (!delta.allFinite()) break;
+    State candidate = *state;
+    candidate.T_frame_kf = SE3d::Exp(delta.head<6>()) * state->T_frame_kf;
+    if (dof == 8) {
+      candidate.affine.a += static_cast<float>(delta[6]);
+      candidate.affine.b += static_cast<float>(delta[7]);
+    }
+    LevelEvaluation next =
+        EvaluateLevel(reference, frame, level, candidate.T_frame_kf, candidate.affine);
+    const double next_cost = Cost(next, candidate, prior);
+    if (next.in_view >= min_points && next_cost < cost) {
+      const double decrease = (cost - next_cost) / cost;
+      *state = candidate;
+      current = std::move(next);
+      cost = next_cost;
+      lambda = lambda <= 0.2 ? 0.0 : 0.5 * lambda;
+      if (decrease < options_.relative_cost_tolerance || delta.squaredNorm() < 1e-12) {
+        ++iterations;
+        break;
+      }
+    } else {
+      if (delta.squaredNorm() < 1e-12) break;
+      lambda = lambda == 0.0 ? 0.2 : 4.0 * lambda;
+    }
+  }
+  return iterations;
+}
+
+TrackingResult Se3Tracker::Finish(const TrackingReference& reference, const Frame& frame,
+                                  const State& state) {
+  const int level = std::min(options_.finest_level, reference.NumLevels() - 1);
+  const LevelEvaluation e = EvaluateLevel(reference, frame, level, state.T_frame_kf, state.affine);
+  TrackingResult result;
+  result.T_kf_frame = state.T_frame_kf.Inverse();
+  result.affine = state.affine;
+  TrackingStats& s = result.stats;
+  const auto total = static_cast<double>(reference.Level(level).Size());
+  s.points_in_view = e.in_view;
+  s.usage = total > 0 ? e.in_view / total : 0.0;
+  if (e.in_view > 0) {
+    s.residual_rms = std::sqrt(e.sum_sq_residual / e.in_view);
+    s.good_ratio = static_cast<double>(e.good) / e.in_view;
+    s.mean_gradient_sq = e.sum_gradient_sq / e.in_view;
+  }
+  const bool finite = result.T_kf_frame.Translation().allFinite() &&
+                      std::isfinite(state.affine.a) && std::isfinite(state.affine.b);
+  if (!finite || e.in_view < std::max(20.0, options_.min_usage * total)) {
+    s.diverged = true;
+    s.reason = "too few points in view or non-finite estimate";
+    result.status = TrackingStatus::kLost;
+  } else if (s.mean_gradient_sq < options_.min_mean_gradient_sq) {
+    s.reason = "frame has no texture where the keyframe points land";
+    result.status = TrackingStatus::kLost;
+  } else if (std::abs(state.affine.a) > options_.max_abs_affine_a) {
+    s.reason = "brightness gain out of range";
+    result.status = TrackingStatus::kLost;
+  } else if (s.good_ratio < options_.min_good_ratio_poor) {
+    s.reason = "most points inconsistent";
+    result.status = TrackingStatus::kLost;
+  } else if (s.good_ratio < options_.min_good_ratio_ok || s.usage < options_.min_usage_ok) {
+    s.reason =
+        s.good_ratio < options_.min_good_ratio_ok ? "many inconsistent points" : "little overlap";
+    result.status = TrackingStatus::kPoor;
+  } else {
+    result.status = TrackingStatus::kOk;
+  }
+  return result;
+}
+
+TrackingResult Se3Tracker::TrackFrom(const TrackingReference& reference, const Frame& frame,
+                                     const SE3d& T_kf_frame, const AffineBrightness& affine_guess) {
+  CheckArgument(frame.NumLevels() >= reference.NumLevels(),
+                "Se3Tracker: the frame has fewer pyramid levels than the keyframe");
+  State state{T_kf_frame.Inverse(), options_.estimate_affine ? affine_guess : AffineBrightness{}};
+  const AffineBrightness prior = state.affine;
+  const int finest = std::min(options_.finest_level, reference.NumLevels() - 1);
+  std::array<int, kMaxPyramidLevels> iterations{};
+  for (int level = reference.NumLevels() - 1; level >= finest; --level) {
+    iterations[static_cast<std::size_t>(level)] = OptimizeLevel(
+        reference, frame, level, MaxIterations(options_.max_iterations, level), prior, &state);
+  }
+  TrackingResult result = Finish(reference, frame, state);
+  result.stats.iterations = iterations;
+  return result;
+}
+
+TrackingResult Se3Tracker::Track(const TrackingReference& reference, const Frame& frame,
+                                 const std::vector<SE3d>& hypotheses,
+                                 const AffineBrightness& affine_guess) {
+  CheckArgument(!hypotheses.empty(), "Se3Tracker::Track: at least one pose hypothesis is needed");
+  TrackingResult best = TrackFrom(reference, frame, hypotheses.front(), affine_guess);
+  best.stats.hypotheses_tried = 1;
+  if (best.status == TrackingStatus::kOk) return best;
+  // Score the alternatives cheaply at the coarsest level.
+  std::vector<SE3d> candidates(hypotheses.begin() + 1, hypotheses.end());
+  constexpr double kSmallRotation = 0.03;  // rad, ~1.7 degrees
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const double sign : {-1.0, 1.0}) {
+      Eigen::Matrix<double, 6, 1> xi = Eigen::Matrix<double, 6, 1>::Zero();
+      xi[3 + axis] = sign * kSmallRotation;
+      candidates.push_back(hypotheses.front() * SE3d::Exp(xi));
+    }
+  }
+  const int coarsest = reference.NumLevels() - 1;
+  const AffineBrightness prior = options_.estimate_affine ? affine_guess : AffineBrightness{};
+  double best_cost = std::numeric_limits<double>::infinity();
+  const SE3d* best_candidate = nullptr;
+  for (const SE3d& candidate : candidates) {
+    State state{candidate.Inverse(), prior};
+    OptimizeLevel(reference, frame, coarsest, options_.hypothesis_iterations, prior, &state);
+    const LevelEvaluation e =
+        EvaluateLevel(reference, frame, coarsest, state.T_frame_kf, state.affine);
+    const double cost =
+        Cost(e, state, prior) /
+        std::max(1e-9, e.in_view / static_cast<double>(reference.Level(coarsest).Size()));
+    if (cost < best_cost) {
+      best_cost = cost;
+      best_candidate = &candidate;
+    }
+  }
+  if (best_candidate != nullptr) {
+    TrackingResult alternative = TrackFrom(reference, frame, *best_candidate, affine_guess);
+    const bool better =
+        alternative.status < best.status ||
+        (alternative.status == best.status && alternative.stats.good_ratio > best.stats.good_ratio);
+    if (better) best = alternative;
+  }
+  best.stats.hypotheses_tried = static_cast<int>(candidates.size()) + 1;
+  return best;
+}
+
+std::vector<SE3d> MotionHypotheses(const SE3d& T_kf_last, const SE3d& T_prev_last) {
+  const SE3d half = SE3d::Exp(0.5 * T_prev_last.Log());
+  return {T_kf_last * T_prev_last, T_kf_last * half, T_kf_last * T_prev_last * T_prev_last,
+          T_kf_last, SE3d()};
+}
+
+}  // namespace parallax

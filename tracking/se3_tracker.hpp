@@ -1,0 +1,102 @@
+#pragma once
+// Direct SE(3) alignment of a frame to a keyframe (docs/math/tracking.md).
+
+#include <vector>
+
+#include "core/frame.hpp"
+#include "core/normal_equations.hpp"
+#include "tracking/tracking_reference.hpp"
+#include "tracking/tracking_result.hpp"
+
+namespace parallax {
+
+struct Se3TrackerOptions {
+  /// Levels tracked: from the coarsest reference level down to this one.
+  int finest_level = 0;
+  /// Max LM iterations per level (index = level; missing entries use the last).
+  std::vector<int> max_iterations = {8, 15, 20, 30, 40};
+  /// Image noise sigma_I, grey levels.
+  float pixel_noise_sigma = 4.0f;
+  /// Huber threshold on the normalised residual r / sigma.
+  float huber_threshold = 1.5f;
+  /// Estimate the affine brightness (a, b) jointly with the pose.
+  bool estimate_affine = true;
+  /// Prior weights pulling a and b towards the guess (per point, in normalised units).
+  float affine_prior_a = 5.0f;
+  float affine_prior_b = 0.01f;
+  /// |a| beyond this (a gain outside [0.3, 3.3]) means the fit explains the frame away.
+  float max_abs_affine_a = 1.2f;
+  /// A point is "good" when |r / sigma| is below this.
+  float good_threshold = 3.0f;
+  /// Status thresholds on the good ratio.
+  float min_good_ratio_ok = 0.6f;
+  float min_good_ratio_poor = 0.35f;
+  /// Lost when fewer than this fraction of reference points (or 20 points) are in view.
+  float min_usage = 0.05f;
+  /// Poor when less than this fraction is in view.
+  float min_usage_ok = 0.3f;
+  /// Lost when the mean |grad I|^2 at warped points is below this (black/flat frame).
+  float min_mean_gradient_sq = 4.0f;
+  /// Stop a level when the cost decreases by less than this fraction.
+  float relative_cost_tolerance = 1e-4f;
+  /// LM iterations for each motion hypothesis at the coarsest level.
+  int hypothesis_iterations = 5;
+
+  void Check() const;
+};
+
+/// Tracks frames against a TrackingReference by coarse-to-fine Levenberg-Marquardt on
+/// T_frame_kf (left increments) and, optionally, affine brightness. The residual is
+/// variance-normalised and Huber-weighted; sums run over fixed blocks of points in parallel
+/// and are added in block order, so results are deterministic. Not thread-safe (owns scratch
+/// buffers); use one tracker per thread.
+class Se3Tracker {
+ public:
+  explicit Se3Tracker(const Se3TrackerOptions& options = {});
+
+  /// Tracks `frame` starting from hypotheses[0] (T_kf_frame guesses, at least one). If that
+  /// is not kOk, the remaining hypotheses and small rotations around the first are scored
+  /// cheaply at the coarsest level and the best is tracked fully; the better result wins.
+  TrackingResult Track(const TrackingReference& reference, const Frame& frame,
+                       const std::vector<SE3d>& hypotheses,
+                       const AffineBrightness& affine_guess = {});
+
+  /// Single coarse-to-fine run from one guess over levels [finest, coarsest].
+  TrackingResult TrackFrom(const TrackingReference& reference, const Frame& frame,
+                           const SE3d& T_kf_frame, const AffineBrightness& affine_guess);
+
+  const Se3TrackerOptions& Options() const { return options_; }
+
+  /// Normal equations (6 pose + 2 affine parameters, per-point normalised, without prior)
+  /// and statistics of `level` at a state. Exposed for tests and the Sim(3) tracker's
+  /// reuse of the kernel.
+  struct LevelEvaluation {
+    NormalEquations<8> equations;
+    int in_view = 0;
+    int good = 0;
+    double sum_sq_residual = 0.0;
+    double sum_gradient_sq = 0.0;
+  };
+  LevelEvaluation EvaluateLevel(const TrackingReference& reference, const Frame& frame, int level,
+                                const SE3d& T_frame_kf, const AffineBrightness& affine);
+
+ private:
+  struct State {
+    SE3d T_frame_kf;
+    AffineBrightness affine;
+  };
+  double Cost(const LevelEvaluation& e, const State& s, const AffineBrightness& prior) const;
+  int OptimizeLevel(const TrackingReference& reference, const Frame& frame, int level,
+                    int max_iterations, const AffineBrightness& prior, State* state);
+  TrackingResult Finish(const TrackingReference& reference, const Frame& frame, const State& state);
+
+  Se3TrackerOptions options_;
+  std::vector<LevelEvaluation> block_sums_;  // scratch, one per block of points
+};
+
+/// Motion hypotheses for the next frame from the last tracked pose and the last inter-frame
+/// motion T_prev_last (pose of the last frame in the previous one): constant velocity, half
+/// and double velocity, zero motion, and the keyframe pose itself.
+std::vector<SE3d> MotionHypotheses(const SE3d& T_kf_last, const SE3d& T_prev_last);
+
+}  // namespace parallax

@@ -1,0 +1,88 @@
+#include "tracking/tracking_reference.hpp"
+
+#include <cmath>
+
+#include "core/check.hpp"
+
+namespace parallax {
+namespace {
+
+void AddPoint(ReferenceLevel* level, const PinholeCamera& camera, const PyramidLevel& image, int x,
+              int y, float idepth, float variance) {
+  level->u.push_back(static_cast<float>(x));
+  level->v.push_back(static_cast<float>(y));
+  level->ray_x.push_back(static_cast<float>((x - camera.Cx()) / camera.Fx()));
+  level->ray_y.push_back(static_cast<float>((y - camera.Cy()) / camera.Fy()));
+  level->idepth.push_back(idepth);
+  level->variance.push_back(variance);
+  level->intensity.push_back(image.intensity(x, y));
+}
+
+// Level l+1 from level l: inverse-variance weighted 2x2 aggregation.
+ReferenceLevel Coarsen(const ReferenceLevel& fine, const Frame& frame, int coarse_level) {
+  const PyramidLevel& image = frame.Level(coarse_level);
+  const int w = image.Width(), h = image.Height();
+  std::vector<double> sum_w(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), 0.0);
+  std::vector<double> sum_wd(sum_w.size(), 0.0);
+  for (std::size_t i = 0; i < fine.Size(); ++i) {
+    const int x = static_cast<int>(fine.u[i]) / 2, y = static_cast<int>(fine.v[i]) / 2;
+    if (x >= w || y >= h) continue;  // odd trailing row/column has no parent
+    const auto index = static_cast<std::size_t>(y * w + x);
+    const double weight = 1.0 / fine.variance[i];
+    sum_w[index] += weight;
+    sum_wd[index] += weight * fine.idepth[i];
+  }
+  ReferenceLevel coarse;
+  const PinholeCamera& camera = frame.Camera(coarse_level);
+  // The 1-pixel border has no gradient (pyramid convention), so it cannot constrain tracking.
+  for (int y = 1; y < h - 1; ++y) {
+    for (int x = 1; x < w - 1; ++x) {
+      const auto index = static_cast<std::size_t>(y * w + x);
+      if (sum_w[index] <= 0.0) continue;
+      AddPoint(&coarse, camera, image, x, y, static_cast<float>(sum_wd[index] / sum_w[index]),
+               static_cast<float>(1.0 / sum_w[index]));
+    }
+  }
+  return coarse;
+}
+
+}  // namespace
+
+void TrackingReferenceOptions::Check() const {
+  CheckOption(std::isfinite(min_gradient) && min_gradient >= 0.0f, "TrackingReferenceOptions",
+              "min_gradient", "must be >= 0");
+  CheckOption(border >= 1, "TrackingReferenceOptions", "border", "must be >= 1");
+}
+
+TrackingReference::TrackingReference(std::shared_ptr<const Frame> keyframe, const ImageF& idepth,
+                                     const ImageF& variance,
+                                     const TrackingReferenceOptions& options)
+    : keyframe_(std::move(keyframe)) {
+  options.Check();
+  CheckArgument(keyframe_ != nullptr, "TrackingReference: keyframe is null");
+  const PyramidLevel& level0 = keyframe_->Level(0);
+  CheckArgument(idepth.Width() == level0.Width() && idepth.Height() == level0.Height() &&
+                    variance.Width() == level0.Width() && variance.Height() == level0.Height(),
+                "TrackingReference: idepth/variance images must have the keyframe's size");
+  const ImageF max_gradient = MaxGradient3x3(level0);
+  ReferenceLevel points;
+  double idepth_sum = 0.0;
+  const int b = options.border;
+  for (int y = b; y < level0.Height() - b; ++y) {
+    for (int x = b; x < level0.Width() - b; ++x) {
+      const float d = idepth(x, y), var = variance(x, y);
+      if (!(d > 0.0f) || !(var > 0.0f) || !std::isfinite(d) || !std::isfinite(var)) continue;
+      if (max_gradient(x, y) < options.min_gradient) continue;
+      AddPoint(&points, keyframe_->Camera(0), level0, x, y, d, var);
+      idepth_sum += d;
+    }
+  }
+  mean_idepth_ =
+      points.Size() ? static_cast<float>(idepth_sum / static_cast<double>(points.Size())) : 0.0f;
+  levels_.push_back(std::move(points));
+  for (int l = 1; l < keyframe_->NumLevels(); ++l) {
+    levels_.push_back(Coarsen(levels_.back(), *keyframe_, l));
+  }
+}
+
+}  // namespace parallax

@@ -1,0 +1,62 @@
+#pragma once
+// The keyframe side of direct image alignment: semi-dense points with inverse depth per
+// pyramid level, built once per keyframe and reused for every tracked frame.
+
+#include <memory>
+#include <vector>
+
+#include "core/frame.hpp"
+#include "core/image.hpp"
+
+namespace parallax {
+
+struct TrackingReferenceOptions {
+  /// A level-0 pixel is used if its 3x3 max gradient magnitude is >= this (grey levels per
+  /// pixel) and it has a valid inverse depth.
+  float min_gradient = 5.0f;
+  /// Pixels this close to the image border are not used (level 0 pixels).
+  int border = 2;
+
+  void Check() const;
+};
+
+/// Points of one pyramid level, structure-of-arrays. Index i refers to the same point in
+/// every array.
+struct ReferenceLevel {
+  std::vector<float> u;      ///< pixel x at this level
+  std::vector<float> v;      ///< pixel y at this level
+  std::vector<float> ray_x;  ///< (u - cx) / fx: the point is (ray_x, ray_y, 1) / idepth
+  std::vector<float> ray_y;
+  std::vector<float> idepth;     ///< inverse depth in the keyframe, 1/unit
+  std::vector<float> variance;   ///< inverse-depth variance
+  std::vector<float> intensity;  ///< keyframe intensity at the pixel (this level)
+
+  std::size_t Size() const { return u.size(); }
+};
+
+/// Semi-dense points of a keyframe for tracking. Level 0 takes every pixel with valid
+/// inverse depth and enough gradient; level l+1 combines the (up to four) level-l points of
+/// each 2x2 block by inverse-variance weighting: idepth = sum(d_i/v_i) / sum(1/v_i),
+/// variance = 1 / sum(1/v_i) (docs/math/tracking.md).
+class TrackingReference {
+ public:
+  /// `idepth` and `variance` are keyframe-sized (level 0); a pixel is valid where idepth > 0
+  /// and variance > 0 (both finite). Throws std::invalid_argument on size mismatch or a null
+  /// keyframe.
+  TrackingReference(std::shared_ptr<const Frame> keyframe, const ImageF& idepth,
+                    const ImageF& variance, const TrackingReferenceOptions& options = {});
+
+  const Frame& Keyframe() const { return *keyframe_; }
+  const std::shared_ptr<const Frame>& KeyframePtr() const { return keyframe_; }
+  int NumLevels() const { return static_cast<int>(levels_.size()); }
+  const ReferenceLevel& Level(int level) const { return levels_[static_cast<std::size_t>(level)]; }
+  /// Mean inverse depth of the level-0 points (1 after scale normalisation).
+  float MeanIdepth() const { return mean_idepth_; }
+
+ private:
+  std::shared_ptr<const Frame> keyframe_;
+  std::vector<ReferenceLevel> levels_;
+  float mean_idepth_ = 0.0f;
+};
+
+}  // namespace parallax
