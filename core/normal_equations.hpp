@@ -39,4 +39,30 @@ struct NormalEquations {
   }
 };
 
+/// Float accumulator for one block of a few thousand residuals: full fixed-size outer
+/// products vectorise well, where a per-residual double rank update does not. Flush() adds the
+/// block into double NormalEquations (keeps the sum precise over many blocks).
+template <int N>
+struct BlockAccumulator {
+  Eigen::Matrix<float, N, N> H = Eigen::Matrix<float, N, N>::Zero();
+  Eigen::Matrix<float, N, 1> g = Eigen::Matrix<float, N, 1>::Zero();
+  float cost = 0.0f;
+  int count = 0;
+
+  void Add(const Eigen::Matrix<float, N, 1>& J, float r, float w, float robust_cost) {
+    const Eigen::Matrix<float, N, 1> wJ = w * J;
+    H.noalias() += wJ * J.transpose();
+    g.noalias() += r * wJ;
+    cost += robust_cost;
+    ++count;
+  }
+
+  void FlushInto(NormalEquations<N>* out) const {
+    out->H += H.template cast<double>().template triangularView<Eigen::Upper>().toDenseMatrix();
+    out->g += g.template cast<double>();
+    out->cost += static_cast<double>(cost);
+    out->count += count;
+  }
+};
+
 }  // namespace parallax

@@ -79,6 +79,7 @@ Se3Tracker::LevelEvaluation Se3Tracker::EvaluateLevel(const TrackingReference& r
   tbb::parallel_for(std::size_t{0}, num_blocks, [&](std::size_t block) {
     LevelEvaluation& sum = block_sums_[block];
     const std::size_t end = std::min(points.Size(), (block + 1) * kBlockSize);
+    BlockAccumulator<8> accumulator;
     PhotometricTerm term;
     for (std::size_t i = block * kBlockSize; i < end; ++i) {
       if (!EvaluatePhotometric(image, camera, R, t, points.ray_x[i], points.ray_y[i],
@@ -92,12 +93,13 @@ Se3Tracker::LevelEvaluation Se3Tracker::EvaluateLevel(const TrackingReference& r
       J.segment<3>(3) = term.p.cross(term.dr_dp);
       J[6] = -gain * points.intensity[i];
       J[7] = -1.0f;
-      sum.equations.Add(J, term.residual, w.weight, w.cost);
+      accumulator.Add(J, term.residual, w.weight, w.cost);
       ++sum.in_view;
       sum.good += term.residual * term.residual < good_sq * term.variance;
       sum.sum_sq_residual += static_cast<double>(term.residual) * term.residual;
       sum.sum_gradient_sq += term.gradient_sq;
     }
+    accumulator.FlushInto(&sum.equations);
   });
   LevelEvaluation total;
   for (const LevelEvaluation& block : block_sums_) {  // fixed order: deterministic
@@ -159,16 +161,26 @@ int Se3Tracker::OptimizeLevel(const TrackingReference& reference, const Frame& f
     const double next_cost = Cost(next, candidate, prior);
     if (next.in_view >= min_points && next_cost < cost) {
       const double decrease = (cost - next_cost) / cost;
+      // A small decrease means convergence only for an undamped step; after a damped one it
+      // may just mean the step was too short.
+      const bool converged = lambda == 0.0 && decrease < options_.relative_cost_tolerance;
       *state = candidate;
       current = std::move(next);
       cost = next_cost;
       lambda = lambda <= 0.2 ? 0.0 : 0.5 * lambda;
-      if (decrease < options_.relative_cost_tolerance || delta.squaredNorm() < 1e-12) {
+      if (converged || delta.squaredNorm() < 1e-12) {
         ++iterations;
         break;
       }
     } else {
-      if (delta.squaredNorm() < 1e-12) break;
+      // A rejected step that changes the cost by less than the tolerance: we are at the
+      // noise floor of the minimum.
+      const bool at_minimum = next.in_view >= min_points && std::isfinite(next_cost) &&
+                              (next_cost - cost) / cost < options_.relative_cost_tolerance;
+      if (at_minimum || delta.squaredNorm() < 1e-12) {
+        ++iterations;
+        break;
+      }
       lambda = lambda == 0.0 ? 0.2 : 4.0 * lambda;
     }
   }
