@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "core/check.hpp"
+#include "tracking/levenberg_marquardt.hpp"
 #include "tracking/photometric_residual.hpp"
 
 namespace parallax {
@@ -125,66 +126,38 @@ double Se3Tracker::Cost(const LevelEvaluation& e, const State& s,
 
 int Se3Tracker::OptimizeLevel(const TrackingReference& reference, const Frame& frame, int level,
                               int max_iterations, const AffineBrightness& prior, State* state) {
-  const int min_points = std::max<int>(
+  const auto linearize = [&](const State& s) {
+    const LevelEvaluation e = EvaluateLevel(reference, frame, level, s.T_frame_kf, s.affine);
+    LinearizedProblem<8> problem;
+    problem.residuals = e.in_view;
+    problem.cost = Cost(e, s, prior);
+    if (e.in_view == 0) return problem;
+    // Per-point normalised normal equations plus the affine prior.
+    problem.H = e.equations.SymmetricH() / e.in_view;
+    problem.g = e.equations.g / e.in_view;
+    if (options_.estimate_affine) {
+      problem.H(6, 6) += options_.affine_prior_a;
+      problem.H(7, 7) += options_.affine_prior_b;
+      problem.g[6] += options_.affine_prior_a * (s.affine.a - prior.a);
+      problem.g[7] += options_.affine_prior_b * (s.affine.b - prior.b);
+    }
+    return problem;
+  };
+  const auto retract = [](const State& s, const Eigen::Matrix<double, 8, 1>& delta) {
+    State next = s;
+    next.T_frame_kf = SE3d::Exp(delta.head<6>()) * s.T_frame_kf;
+    next.affine.a += static_cast<float>(delta[6]);
+    next.affine.b += static_cast<float>(delta[7]);
+    return next;
+  };
+  LmSettings settings;
+  settings.max_iterations = max_iterations;
+  settings.relative_tolerance = options_.relative_cost_tolerance;
+  settings.min_residuals = std::max<int>(
       20,
       static_cast<int>(options_.min_usage * static_cast<double>(reference.Level(level).Size())));
-  LevelEvaluation current =
-      EvaluateLevel(reference, frame, level, state->T_frame_kf, state->affine);
-  double cost = Cost(current, *state, prior);
-  double lambda = 0.0;
-  int iterations = 0;
-  for (; iterations < max_iterations; ++iterations) {
-    if (current.in_view < min_points) break;
-    // Per-point normalised normal equations plus the affine prior.
-    const double n = current.in_view;
-    Eigen::Matrix<double, 8, 8> H = current.equations.SymmetricH() / n;
-    Eigen::Matrix<double, 8, 1> g = current.equations.g / n;
-    const int dof = options_.estimate_affine ? 8 : 6;
-    if (options_.estimate_affine) {
-      H(6, 6) += options_.affine_prior_a;
-      H(7, 7) += options_.affine_prior_b;
-      g[6] += options_.affine_prior_a * (state->affine.a - prior.a);
-      g[7] += options_.affine_prior_b * (state->affine.b - prior.b);
-    }
-    Eigen::MatrixXd A = H.topLeftCorner(dof, dof);
-    A.diagonal() *= 1.0 + lambda;
-    const Eigen::VectorXd delta = A.ldlt().solve(-g.head(dof));
-    if (!delta.allFinite()) break;
-    State candidate = *state;
-    candidate.T_frame_kf = SE3d::Exp(delta.head<6>()) * state->T_frame_kf;
-    if (dof == 8) {
-      candidate.affine.a += static_cast<float>(delta[6]);
-      candidate.affine.b += static_cast<float>(delta[7]);
-    }
-    LevelEvaluation next =
-        EvaluateLevel(reference, frame, level, candidate.T_frame_kf, candidate.affine);
-    const double next_cost = Cost(next, candidate, prior);
-    if (next.in_view >= min_points && next_cost < cost) {
-      const double decrease = (cost - next_cost) / cost;
-      // A small decrease means convergence only for an undamped step; after a damped one it
-      // may just mean the step was too short.
-      const bool converged = lambda == 0.0 && decrease < options_.relative_cost_tolerance;
-      *state = candidate;
-      current = std::move(next);
-      cost = next_cost;
-      lambda = lambda <= 0.2 ? 0.0 : 0.5 * lambda;
-      if (converged || delta.squaredNorm() < 1e-12) {
-        ++iterations;
-        break;
-      }
-    } else {
-      // A rejected step that changes the cost by less than the tolerance: we are at the
-      // noise floor of the minimum.
-      const bool at_minimum = next.in_view >= min_points && std::isfinite(next_cost) &&
-                              (next_cost - cost) / cost < options_.relative_cost_tolerance;
-      if (at_minimum || delta.squaredNorm() < 1e-12) {
-        ++iterations;
-        break;
-      }
-      lambda = lambda == 0.0 ? 0.2 : 4.0 * lambda;
-    }
-  }
-  return iterations;
+  settings.active = options_.estimate_affine ? 8 : 6;
+  return MinimizeLevenbergMarquardt<8>(state, linearize, retract, settings);
 }
 
 TrackingResult Se3Tracker::Finish(const TrackingReference& reference, const Frame& frame,

@@ -79,6 +79,17 @@ TEST_P(PhotometricJacobianTest, MatchesNumericDifferentiation) {
                            (2 * h);
     EXPECT_NEAR(J_analytic[k], numeric, 0.01 * std::abs(numeric) + 0.05) << "pose parameter " << k;
   }
+  // Sim(3) scale column: p = exp(sigma) (R P) + exp(sigma) t under a left scale increment,
+  // so dr/dsigma = dr/dp . p.
+  const double s = 1e-3;
+  KernelInput scaled_up = in, scaled_down = in;
+  scaled_up.M *= std::exp(static_cast<float>(s));
+  scaled_up.t *= std::exp(static_cast<float>(s));
+  scaled_down.M *= std::exp(static_cast<float>(-s));
+  scaled_down.t *= std::exp(static_cast<float>(-s));
+  const double numeric_scale =
+      (Residual(image.level, cam, scaled_up) - Residual(image.level, cam, scaled_down)) / (2 * s);
+  EXPECT_NEAR(term.dr_dp.dot(term.p), numeric_scale, 0.01 * std::abs(numeric_scale) + 0.05);
   // Affine terms: r = I - exp(a) I_ref - b, so dr/da = -exp(a) I_ref and dr/db = -1.
   KernelInput brighter = in;
   brighter.gain = in.gain * std::exp(1e-3f);

@@ -1,0 +1,68 @@
+#pragma once
+// The Levenberg-Marquardt loop shared by the SE(3) and Sim(3) trackers.
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <cmath>
+#include <limits>
+
+namespace parallax {
+
+/// A problem linearised at a state: cost and normal equations (already normalised and with
+/// priors), and how many residuals it had.
+template <int N>
+struct LinearizedProblem {
+  Eigen::Matrix<double, N, N> H = Eigen::Matrix<double, N, N>::Zero();
+  Eigen::Matrix<double, N, 1> g = Eigen::Matrix<double, N, 1>::Zero();
+  double cost = std::numeric_limits<double>::infinity();
+  int residuals = 0;
+};
+
+struct LmSettings {
+  int max_iterations = 10;
+  /// Converged when an undamped step, or a rejected one, changes the cost by less than this
+  /// fraction (the noise floor of the minimum).
+  double relative_tolerance = 1e-3;
+  /// Fewer residuals than this: the state is not trusted (stop).
+  int min_residuals = 20;
+  /// Only the first `active` parameters are solved for (others stay fixed); -1: all.
+  int active = -1;
+};
+
+/// Minimises from *state. `linearize(state)` returns LinearizedProblem<N>; `retract(state,
+/// delta)` applies a step. Steps solve (H + lambda diag(H)) delta = -g; lambda is 0 while
+/// steps succeed, 0.2 after a failure and x4 per further failure (LSD-SLAM's schedule).
+/// Returns the number of iterations.
+template <int N, typename State, typename Linearize, typename Retract>
+int MinimizeLevenbergMarquardt(State* state, const Linearize& linearize, const Retract& retract,
+                               const LmSettings& settings) {
+  const int active = settings.active < 0 ? N : settings.active;
+  LinearizedProblem<N> current = linearize(*state);
+  double lambda = 0.0;
+  int iterations = 0;
+  while (iterations < settings.max_iterations && current.residuals >= settings.min_residuals) {
+    ++iterations;
+    Eigen::MatrixXd A = current.H.topLeftCorner(active, active);
+    A.diagonal() *= 1.0 + lambda;
+    Eigen::Matrix<double, N, 1> delta = Eigen::Matrix<double, N, 1>::Zero();
+    delta.head(active) = A.ldlt().solve(-current.g.head(active));
+    if (!delta.allFinite()) break;
+    const State candidate = retract(*state, delta);
+    LinearizedProblem<N> next = linearize(candidate);
+    const bool valid = next.residuals >= settings.min_residuals && std::isfinite(next.cost);
+    const double change = valid ? (next.cost - current.cost) / current.cost : 1.0;
+    if (valid && next.cost < current.cost) {
+      const bool converged = lambda == 0.0 && -change < settings.relative_tolerance;
+      *state = candidate;
+      current = std::move(next);
+      lambda = lambda <= 0.2 ? 0.0 : 0.5 * lambda;
+      if (converged) break;
+    } else {
+      if ((valid && change < settings.relative_tolerance) || delta.squaredNorm() < 1e-12) break;
+      lambda = lambda == 0.0 ? 0.2 : 4.0 * lambda;
+    }
+  }
+  return iterations;
+}
+
+}  // namespace parallax

@@ -1,0 +1,241 @@
+#include "tracking/sim3_tracker.hpp"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+
+#include "core/check.hpp"
+#include "core/normal_equations.hpp"
+#include "tracking/levenberg_marquardt.hpp"
+#include "tracking/photometric_residual.hpp"
+
+namespace parallax {
+namespace {
+
+constexpr int kParams = 9;  // 7 Sim(3) + 2 affine
+
+struct State {
+  Sim3d S_other_ref;
+  AffineBrightness affine;
+};
+
+// Dense inverse depth and variance of one level of the other keyframe (0 = none).
+struct DepthLevel {
+  ImageF idepth;
+  ImageF variance;
+};
+
+DepthLevel Densify(const TrackingReference& reference, int level) {
+  const PyramidLevel& image = reference.Keyframe().Level(level);
+  DepthLevel dense{ImageF(image.Width(), image.Height(), 0.0f),
+                   ImageF(image.Width(), image.Height(), 0.0f)};
+  const ReferenceLevel& points = reference.Level(level);
+  for (std::size_t i = 0; i < points.Size(); ++i) {
+    const int x = static_cast<int>(points.u[i]), y = static_cast<int>(points.v[i]);
+    dense.idepth(x, y) = points.idepth[i];
+    dense.variance(x, y) = points.variance[i];
+  }
+  return dense;
+}
+
+struct Evaluation {
+  NormalEquations<kParams> equations;
+  int in_view = 0;
+  int good = 0;
+  int depth_residuals = 0;
+  double sum_sq_residual = 0.0;
+  double sum_gradient_sq = 0.0;
+};
+
+Evaluation EvaluateLevel(const Sim3TrackerOptions& options, const ReferenceLevel& points,
+                         const PyramidLevel& image, const PinholeCamera& K, const DepthLevel& depth,
+                         const State& state) {
+  const LevelCamera camera{static_cast<float>(K.Fx()),        static_cast<float>(K.Fy()),
+                           static_cast<float>(K.Cx()),        static_cast<float>(K.Cy()),
+                           static_cast<float>(K.Width() - 2), static_cast<float>(K.Height() - 2)};
+  const Eigen::Matrix3f M =
+      (state.S_other_ref.Scale() * state.S_other_ref.Rotation().Matrix()).cast<float>();
+  const Eigen::Vector3f t = state.S_other_ref.Translation().cast<float>();
+  const float gain = state.affine.Gain(), offset = state.affine.b;
+  const float noise_var = options.pixel_noise_sigma * options.pixel_noise_sigma;
+  const float good_sq = options.good_threshold * options.good_threshold;
+  Evaluation e;
+  BlockAccumulator<kParams> block;
+  PhotometricTerm term;
+  for (std::size_t i = 0; i < points.Size(); ++i) {
+    if (!EvaluatePhotometric(image, camera, M, t, points.ray_x[i], points.ray_y[i],
+                             points.idepth[i], points.variance[i], points.intensity[i], gain,
+                             offset, noise_var, &term)) {
+      continue;
+    }
+    // Photometric residual: J = [dr/dp, p x dr/dp, dr/dp . p, -exp(a) I_ref, -1].
+    Eigen::Matrix<float, kParams, 1> J;
+    J.head<3>() = term.dr_dp;
+    J.segment<3>(3) = term.p.cross(term.dr_dp);
+    J[6] = term.dr_dp.dot(term.p);
+    J[7] = -gain * points.intensity[i];
+    J[8] = -1.0f;
+    const RobustWeight w = HuberWeight(term.residual, term.variance, options.huber_threshold);
+    block.Add(J, term.residual, w.weight, w.cost);
+    ++e.in_view;
+    e.good += term.residual * term.residual < good_sq * term.variance;
+    e.sum_sq_residual += static_cast<double>(term.residual) * term.residual;
+    e.sum_gradient_sq += term.gradient_sq;
+    // Inverse-depth residual against the other keyframe's depth at the nearest pixel.
+    const float z = term.p.z();
+    const int u = static_cast<int>(std::lround(camera.fx * term.p.x() / z + camera.cx));
+    const int v = static_cast<int>(std::lround(camera.fy * term.p.y() / z + camera.cy));
+    const float other_idepth = depth.idepth(u, v);
+    if (!(other_idepth > 0.0f)) continue;
+    const float r_d = 1.0f / z - other_idepth;
+    // d(1/z)/d idepth = (z - t_z) / (z^2 idepth) (LSD-SLAM's Sim3Tracker).
+    const float dd = (z - t.z()) / (z * z * points.idepth[i]);
+    const float var_d = depth.variance(u, v) + dd * dd * points.variance[i];
+    const float inv_z2 = 1.0f / (z * z);
+    Eigen::Matrix<float, kParams, 1> J_d;
+    J_d << 0.0f, 0.0f, -inv_z2, -term.p.y() * inv_z2, term.p.x() * inv_z2, 0.0f, -z * inv_z2, 0.0f,
+        0.0f;
+    const RobustWeight wd = HuberWeight(r_d, var_d, options.depth_huber_threshold);
+    block.Add(J_d, r_d, options.depth_weight * wd.weight, options.depth_weight * wd.cost);
+    ++e.depth_residuals;
+  }
+  block.FlushInto(&e.equations);
+  return e;
+}
+
+int MaxIterations(const std::vector<int>& per_level, int level) {
+  return per_level[std::min(static_cast<std::size_t>(level), per_level.size() - 1)];
+}
+
+}  // namespace
+
+void Sim3TrackerOptions::Check() const {
+  const char* s = "Sim3TrackerOptions";
+  CheckOption(finest_level >= 0 && finest_level < kMaxPyramidLevels, s, "finest_level",
+              "must be in [0, 7]");
+  CheckOption(!max_iterations.empty(), s, "max_iterations", "must not be empty");
+  CheckOption(pixel_noise_sigma > 0.0f, s, "pixel_noise_sigma", "must be > 0");
+  CheckOption(huber_threshold > 0.0f && depth_huber_threshold > 0.0f, s, "huber_threshold",
+              "must be > 0");
+  CheckOption(depth_weight >= 0.0f, s, "depth_weight", "must be >= 0");
+  CheckOption(affine_prior_a >= 0.0f && affine_prior_b >= 0.0f, s, "affine_prior_a/b",
+              "must be >= 0");
+  CheckOption(min_good_ratio_poor <= min_good_ratio_ok, s, "min_good_ratio_poor",
+              "must be <= min_good_ratio_ok");
+  CheckOption(min_usage >= 0.0f && min_usage < 1.0f, s, "min_usage", "must be in [0, 1)");
+}
+
+Sim3Tracker::Sim3Tracker(const Sim3TrackerOptions& options) : options_(options) {
+  options_.Check();
+}
+
+Sim3TrackingResult Sim3Tracker::Track(const TrackingReference& reference,
+                                      const TrackingReference& other,
+                                      const Sim3d& S_ref_other_guess,
+                                      const AffineBrightness& affine_guess) {
+  CheckArgument(reference.NumLevels() == other.NumLevels() &&
+                    reference.Keyframe().Level(0).Width() == other.Keyframe().Level(0).Width() &&
+                    reference.Keyframe().Level(0).Height() == other.Keyframe().Level(0).Height(),
+                "Sim3Tracker: the two keyframes must have the same image size and pyramid");
+  State state{S_ref_other_guess.Inverse(),
+              options_.estimate_affine ? affine_guess : AffineBrightness{}};
+  const AffineBrightness prior = state.affine;
+  const int finest = std::min(options_.finest_level, reference.NumLevels() - 1);
+  Sim3TrackingResult result;
+  Evaluation last;
+  for (int level = reference.NumLevels() - 1; level >= finest; --level) {
+    const DepthLevel depth = Densify(other, level);
+    const ReferenceLevel& points = reference.Level(level);
+    const PyramidLevel& image = other.Keyframe().Level(level);
+    const PinholeCamera& K = other.Keyframe().Camera(level);
+    const auto linearize = [&](const State& s) {
+      const Evaluation e = EvaluateLevel(options_, points, image, K, depth, s);
+      LinearizedProblem<kParams> problem;
+      problem.residuals = e.in_view;
+      if (e.in_view == 0) return problem;
+      const double n = e.in_view;
+      problem.H = e.equations.SymmetricH() / n;
+      problem.g = e.equations.g / n;
+      problem.cost = e.equations.cost / n;
+      if (options_.estimate_affine) {
+        const double da = s.affine.a - prior.a, db = s.affine.b - prior.b;
+        problem.H(7, 7) += options_.affine_prior_a;
+        problem.H(8, 8) += options_.affine_prior_b;
+        problem.g[7] += options_.affine_prior_a * da;
+        problem.g[8] += options_.affine_prior_b * db;
+        problem.cost +=
+            0.5 * (options_.affine_prior_a * da * da + options_.affine_prior_b * db * db);
+      }
+      return problem;
+    };
+    const auto retract = [](const State& s, const Eigen::Matrix<double, kParams, 1>& delta) {
+      State next = s;
+      next.S_other_ref = Sim3d::Exp(delta.head<7>()) * s.S_other_ref;
+      next.affine.a += static_cast<float>(delta[7]);
+      next.affine.b += static_cast<float>(delta[8]);
+      return next;
+    };
+    LmSettings settings;
+    settings.max_iterations = MaxIterations(options_.max_iterations, level);
+    settings.relative_tolerance = options_.relative_cost_tolerance;
+    settings.min_residuals =
+        std::max(20, static_cast<int>(options_.min_usage * static_cast<float>(points.Size())));
+    settings.active = options_.estimate_affine ? kParams : 7;
+    try {
+      result.stats.iterations[static_cast<std::size_t>(level)] =
+          MinimizeLevenbergMarquardt<kParams>(&state, linearize, retract, settings);
+    } catch (const std::invalid_argument&) {
+      // A step produced a non-positive or non-finite scale: divergence, reported below.
+      result.stats.diverged = true;
+      break;
+    }
+    if (level == finest) last = EvaluateLevel(options_, points, image, K, depth, state);
+  }
+  result.S_ref_other = state.S_other_ref.Inverse();
+  result.affine = state.affine;
+  result.depth_residuals = last.depth_residuals;
+  TrackingStats& s = result.stats;
+  const auto total = static_cast<double>(reference.Level(finest).Size());
+  s.points_in_view = last.in_view;
+  s.usage = total > 0 ? last.in_view / total : 0.0;
+  if (last.in_view > 0) {
+    s.residual_rms = std::sqrt(last.sum_sq_residual / last.in_view);
+    s.good_ratio = static_cast<double>(last.good) / last.in_view;
+    s.mean_gradient_sq = last.sum_gradient_sq / last.in_view;
+    // Marginalise the affine parameters: I = H_pp - H_pa H_aa^-1 H_ap (raw sums, not per point).
+    const Eigen::Matrix<double, kParams, kParams> H = last.equations.SymmetricH();
+    Eigen::Matrix<double, 7, 7> info = H.topLeftCorner<7, 7>();
+    if (options_.estimate_affine) {
+      const Eigen::Matrix2d H_aa = H.bottomRightCorner<2, 2>();
+      info -= H.topRightCorner<7, 2>() * H_aa.inverse() * H.bottomLeftCorner<2, 7>();
+    }
+    // The Hessian is for left increments of S_other_ref; S_ref_other' = Exp(-Adj(S_ref_other)
+    // delta) S_ref_other, so its information is Adj^-T H Adj^-1.
+    const Eigen::Matrix<double, 7, 7> adj_inv = result.S_ref_other.Adjoint().inverse();
+    result.information = adj_inv.transpose() * info * adj_inv;
+  }
+  if (s.diverged || last.in_view < std::max(20.0, options_.min_usage * total)) {
+    s.diverged = true;
+    s.reason = "diverged or too few points in view";
+    result.status = TrackingStatus::kLost;
+  } else if (s.good_ratio < options_.min_good_ratio_poor) {
+    s.reason = "most points inconsistent";
+    result.status = TrackingStatus::kLost;
+  } else if (s.good_ratio < options_.min_good_ratio_ok) {
+    s.reason = "many inconsistent points";
+    result.status = TrackingStatus::kPoor;
+  } else {
+    result.status = TrackingStatus::kOk;
+  }
+  return result;
+}
+
+double ReciprocalMahalanobis(const Sim3TrackingResult& a_b, const Sim3TrackingResult& b_a) {
+  const Eigen::Matrix<double, 7, 1> delta = (a_b.S_ref_other * b_a.S_ref_other).Log();
+  const Eigen::Matrix<double, 7, 7> adj = a_b.S_ref_other.Adjoint();
+  const Eigen::Matrix<double, 7, 7> covariance =
+      a_b.information.inverse() + adj * b_a.information.inverse() * adj.transpose();
+  return delta.dot(covariance.inverse() * delta);
+}
+
+}  // namespace parallax
