@@ -1,0 +1,71 @@
+#pragma once
+// The per-keyframe inverse-depth filter: stereo updates with Kalman fusion, regularisation,
+// hole filling, propagation to a new keyframe and scale normalisation
+// (docs/math/depth_filter.md).
+
+#include "core/frame.hpp"
+#include "core/se3.hpp"
+#include "depth/depth_map.hpp"
+#include "depth/epipolar_search.hpp"
+
+namespace parallax {
+
+/// Counts of one stereo update.
+struct DepthUpdateStats {
+  int attempted = 0;
+  int created = 0;       ///< new estimates from a full-range search
+  int fused = 0;         ///< consistent observations fused into a prior
+  int inconsistent = 0;  ///< observation far from the prior (variance inflated)
+  int dropped = 0;       ///< estimates removed (variance beyond max_variance)
+  int ambiguous = 0;
+  int no_match = 0;
+  int out_of_image = 0;
+  int skipped = 0;  ///< gradient not along the epipolar line, or too much rescale
+};
+
+struct PropagationStats {
+  int source = 0;      ///< valid pixels in the old map
+  int propagated = 0;  ///< landed in the new keyframe with consistent intensity
+  int out_of_view = 0;
+  int rejected = 0;  ///< intensity mismatch or no gradient in the new keyframe
+  int merged = 0;    ///< collisions fused
+  int occluded = 0;  ///< collisions where the nearer point won
+};
+
+class DepthFilter {
+ public:
+  explicit DepthFilter(const DepthFilterOptions& options = {});
+
+  /// Observes every eligible pixel in `frame` (known pose): valid pixels search mu +- 2 sigma
+  /// and fuse; invalid ones search the full range and are created. Pixels are independent,
+  /// so rows run in parallel with deterministic results. Then regularises.
+  DepthUpdateStats Update(InverseDepthMap* map, const StereoFrame& frame) const;
+
+  /// Smoothed idepth/variance from compatible neighbours in a 5x5 window; pixels with too
+  /// little neighbour support are removed (outliers).
+  void Regularize(InverseDepthMap* map) const;
+  /// Fills empty eligible pixels whose neighbourhood has enough valid support.
+  int FillHoles(InverseDepthMap* map) const;
+
+  /// Moves the map into a new keyframe (T_new_old: old keyframe -> new), transporting
+  /// variances ((d_new/d_old)^4), resolving collisions (inconsistent: keep the nearer;
+  /// consistent: fuse), then regularises and fills holes.
+  InverseDepthMap Propagate(const InverseDepthMap& old_map,
+                            std::shared_ptr<const Frame> new_keyframe, const SE3d& T_new_old,
+                            float gain = 1.0f, float offset = 0.0f,
+                            PropagationStats* stats = nullptr) const;
+
+  /// Rescales the map so the mean smoothed inverse depth is 1 and returns the factor s applied
+  /// (idepth x s). The keyframe's world scale changes by 1/s; its Sim(3) pose must take it.
+  /// Returns 1 and leaves the map unchanged when it has no estimates.
+  float NormalizeScale(InverseDepthMap* map) const;
+
+  const DepthFilterOptions& Options() const { return options_; }
+
+ private:
+  void UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search, int x, int y,
+                   DepthUpdateStats* stats) const;
+  DepthFilterOptions options_;
+};
+
+}  // namespace parallax

@@ -1,0 +1,137 @@
+#include "depth/depth_map.hpp"
+
+#include <cmath>
+#include <random>
+
+#include "core/check.hpp"
+
+namespace parallax {
+
+void DepthFilterOptions::Check() const {
+  const char* s = "DepthFilterOptions";
+  CheckOption(min_gradient >= 0.0f, s, "min_gradient", "must be >= 0");
+  CheckOption(pixel_noise_sigma > 0.0f, s, "pixel_noise_sigma", "must be > 0");
+  CheckOption(min_idepth > 0.0f && max_idepth > min_idepth, s, "min_idepth/max_idepth",
+              "need 0 < min < max");
+  CheckOption(initial_variance > 0.0f && max_variance >= initial_variance, s, "initial_variance",
+              "must be in (0, max_variance]");
+  CheckOption(process_noise_factor >= 1.0f, s, "process_noise_factor", "must be >= 1");
+  CheckOption(inconsistency_variance_factor >= 1.0f, s, "inconsistency_variance_factor",
+              "must be >= 1");
+  CheckOption(epipolar_line_sigma >= 0.0f, s, "epipolar_line_sigma", "must be >= 0");
+  CheckOption(max_ssd > 0.0f, s, "max_ssd", "must be > 0");
+  CheckOption(ambiguity_ratio >= 1.0f, s, "ambiguity_ratio", "must be >= 1");
+  CheckOption(max_search_length >= 3.0f, s, "max_search_length", "must be >= 3");
+  CheckOption(min_rescale > 0.0f && max_rescale > min_rescale, s, "min_rescale/max_rescale",
+              "need 0 < min < max");
+}
+
+InverseDepthMap::InverseDepthMap(std::shared_ptr<const Frame> keyframe,
+                                 const DepthFilterOptions& options)
+    : keyframe_(std::move(keyframe)), width_(0), height_(0), options_(options) {
+  options_.Check();
+  CheckArgument(keyframe_ != nullptr, "InverseDepthMap: keyframe is null");
+  width_ = keyframe_->Level(0).Width();
+  height_ = keyframe_->Level(0).Height();
+  const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
+  idepth.assign(n, 0.0f);
+  variance.assign(n, 0.0f);
+  idepth_smoothed.assign(n, 0.0f);
+  variance_smoothed.assign(n, 0.0f);
+  validity.assign(n, 0.0f);
+  blacklist.assign(n, 0);
+  valid.assign(n, 0);
+  eligible.assign(n, 0);
+  observations.assign(n, 0);
+  const ImageF max_gradient = MaxGradient3x3(keyframe_->Level(0));
+  constexpr int kBorder = 3;  // the 5-sample pattern must stay inside the image
+  for (int y = kBorder; y < height_ - kBorder; ++y) {
+    for (int x = kBorder; x < width_ - kBorder; ++x) {
+      eligible[Index(x, y)] = max_gradient(x, y) >= options_.min_gradient;
+    }
+  }
+}
+
+void InverseDepthMap::InitializeRandom(float mean_idepth) {
+  CheckArgument(mean_idepth > 0.0f && std::isfinite(mean_idepth),
+                "InitializeRandom: mean_idepth must be > 0");
+  std::mt19937_64 rng(options_.seed);
+  for (std::size_t i = 0; i < valid.size(); ++i) {
+    // Uniform in [0.5, 1.5) from 24 random bits (std distributions are not portable).
+    const float u = static_cast<float>(rng() >> 40) / 16777216.0f;
+    if (!eligible[i]) continue;
+    idepth[i] = idepth_smoothed[i] = (0.5f + u) * mean_idepth;
+    variance[i] = variance_smoothed[i] = options_.initial_variance * mean_idepth * mean_idepth;
+    validity[i] = options_.initial_validity;
+    valid[i] = 1;
+  }
+}
+
+void InverseDepthMap::InitializeFromPrior(const ImageF& prior_idepth,
+                                          const ImageF& prior_variance) {
+  CheckArgument(prior_idepth.Width() == width_ && prior_idepth.Height() == height_ &&
+                    prior_variance.Width() == width_ && prior_variance.Height() == height_,
+                "InitializeFromPrior: prior images must have the keyframe's size");
+  for (std::size_t i = 0; i < valid.size(); ++i) {
+    const float d = prior_idepth.Data()[i], v = prior_variance.Data()[i];
+    valid[i] = eligible[i] && d > 0.0f && v > 0.0f && std::isfinite(d) && std::isfinite(v);
+    if (!valid[i]) continue;
+    idepth[i] = idepth_smoothed[i] = d;
+    variance[i] = variance_smoothed[i] = v;
+    validity[i] = options_.initial_validity;
+    observations[i] = 1;  // a prior counts as one observation
+  }
+}
+
+std::size_t InverseDepthMap::NumConfirmed() const {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < valid.size(); ++i) n += IsConfirmed(i);
+  return n;
+}
+
+std::size_t InverseDepthMap::NumValid() const {
+  std::size_t n = 0;
+  for (const auto v : valid) n += v;
+  return n;
+}
+
+std::size_t InverseDepthMap::NumEligible() const {
+  std::size_t n = 0;
+  for (const auto e : eligible) n += e;
+  return n;
+}
+
+double InverseDepthMap::MeanSmoothedIdepth() const {
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < valid.size(); ++i) {
+    if (!valid[i]) continue;
+    sum += idepth_smoothed[i];
+    ++n;
+  }
+  return n ? sum / static_cast<double>(n) : 0.0;
+}
+
+void InverseDepthMap::Rescale(float s) {
+  CheckArgument(s > 0.0f && std::isfinite(s),
+                "InverseDepthMap::Rescale: scale must be finite and > 0");
+  for (std::size_t i = 0; i < valid.size(); ++i) {
+    idepth[i] *= s;
+    idepth_smoothed[i] *= s;
+    variance[i] *= s * s;
+    variance_smoothed[i] *= s * s;
+  }
+}
+
+void InverseDepthMap::ExportSmoothed(ImageF* out_idepth, ImageF* out_variance,
+                                     bool confirmed_only) const {
+  *out_idepth = ImageF(width_, height_, 0.0f);
+  *out_variance = ImageF(width_, height_, 0.0f);
+  for (std::size_t i = 0; i < valid.size(); ++i) {
+    if (!valid[i] || (confirmed_only && !IsConfirmed(i))) continue;
+    out_idepth->Data()[i] = idepth_smoothed[i];
+    out_variance->Data()[i] = variance_smoothed[i];
+  }
+}
+
+}  // namespace parallax

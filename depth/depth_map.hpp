@@ -1,0 +1,73 @@
+#pragma once
+// Per-keyframe inverse-depth map, structure-of-arrays over the keyframe's level-0 pixels.
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/frame.hpp"
+#include "core/image.hpp"
+#include "depth/depth_options.hpp"
+
+namespace parallax {
+
+/// Per-pixel state of the inverse-depth filter (index = y * width + x). A pixel has an
+/// estimate when valid[i] != 0; its raw idepth/variance are filtered by Kalman fusion and
+/// the smoothed ones (regularised over compatible neighbours) are what tracking and
+/// propagation use.
+class InverseDepthMap {
+ public:
+  /// An empty map for `keyframe`: no estimates; pixels eligible where the 3x3 max gradient is
+  /// >= options.min_gradient.
+  InverseDepthMap(std::shared_ptr<const Frame> keyframe, const DepthFilterOptions& options);
+
+  const Frame& Keyframe() const { return *keyframe_; }
+  const std::shared_ptr<const Frame>& KeyframePtr() const { return keyframe_; }
+  int Width() const { return width_; }
+  int Height() const { return height_; }
+  std::size_t Index(int x, int y) const {
+    return static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
+           static_cast<std::size_t>(x);
+  }
+
+  /// LSD-style start: every eligible pixel gets idepth uniform in [0.5, 1.5] * mean_idepth and
+  /// variance initial_variance * mean_idepth^2 (deterministic for options.seed).
+  void InitializeRandom(float mean_idepth = 1.0f);
+  /// From a prior (sparse or dense): eligible pixels with prior idepth > 0 and variance > 0.
+  void InitializeFromPrior(const ImageF& idepth, const ImageF& variance);
+
+  std::size_t NumValid() const;
+  std::size_t NumEligible() const;
+  /// Mean smoothed inverse depth of valid pixels (0 if none).
+  double MeanSmoothedIdepth() const;
+  /// Multiplies all inverse depths by s and variances by s^2 (scale change of the map).
+  void Rescale(float s);
+  /// Smoothed idepth and variance as images (0 where invalid, or unconfirmed when
+  /// confirmed_only), e.g. for TrackingReference.
+  void ExportSmoothed(ImageF* idepth, ImageF* variance, bool confirmed_only = false) const;
+
+  // Per-pixel arrays (public for the filter stages; sized Width() * Height()).
+  std::vector<float> idepth;
+  std::vector<float> variance;
+  std::vector<float> idepth_smoothed;
+  std::vector<float> variance_smoothed;
+  std::vector<float> validity;
+  std::vector<std::int16_t> blacklist;  ///< < 0: repeatedly failed; skipped below -1
+  std::vector<std::uint8_t> valid;
+  std::vector<std::uint8_t> eligible;  ///< enough gradient to be estimated
+  /// Stereo observations fused (or that created the estimate); 0 for random or hole-filled
+  /// values, which are hypotheses until observed.
+  std::vector<std::uint16_t> observations;
+
+  /// Valid with at least one stereo observation (or from a prior).
+  bool IsConfirmed(std::size_t i) const { return valid[i] && observations[i] > 0; }
+  std::size_t NumConfirmed() const;
+
+ private:
+  std::shared_ptr<const Frame> keyframe_;
+  int width_;
+  int height_;
+  DepthFilterOptions options_;
+};
+
+}  // namespace parallax

@@ -1,0 +1,55 @@
+#pragma once
+// Options of the inverse-depth filter (depth/). Defaults follow LSD-SLAM's DepthMap where
+// they are scale-independent; inverse-depth limits are in the map's units (1/unit).
+
+#include <cstdint>
+
+namespace parallax {
+
+struct DepthFilterOptions {
+  /// Pixels whose 3x3 max gradient is below this are never estimated (grey levels / pixel).
+  float min_gradient = 5.0f;
+  /// Image noise sigma_I (grey levels).
+  float pixel_noise_sigma = 4.0f;
+  /// Inverse-depth search range for new pixels, 1/unit.
+  float min_idepth = 1e-3f;
+  float max_idepth = 20.0f;
+  /// Variance of a random initialisation and of hole-filled pixels (relative to idepth^2 of
+  /// the mean inverse depth 1: LSD's 0.5 * MAX_VAR).
+  float initial_variance = 0.125f;
+  /// An estimate whose variance exceeds this is dropped (LSD's MAX_VAR).
+  float max_variance = 0.25f;
+  /// Multiplicative process noise applied to the prior variance before each fusion.
+  float process_noise_factor = 1.01f;
+  /// Inconsistent observation: prior variance x this.
+  float inconsistency_variance_factor = 1.1f;
+  /// Position uncertainty of the epipolar line, pixels (pose error), per unit tracking
+  /// residual quality (LSD's 0.25 * (1 + residual)).
+  float epipolar_line_sigma = 0.25f;
+  /// SSD over 5 samples: reject the best match above this plus 20 sqrt(gradient along line).
+  float max_ssd = 1300.0f;
+  /// Ambiguous when a non-adjacent runner-up is below this factor times the best SSD.
+  float ambiguity_ratio = 1.5f;
+  /// Longest searched epipolar segment, pixels.
+  float max_search_length = 30.0f;
+  /// Gates: squared gradient along the epipolar line >= this, and its share of |grad|^2.
+  float min_gradient_along_line_sq = 4.0f;
+  float min_gradient_along_line_share = 0.09f;
+  /// Allowed change of the apparent pattern scale between keyframe and frame.
+  float min_rescale = 0.7f;
+  float max_rescale = 1.4f;
+  /// Validity counter (LSD): start, gain per consistent observation, cap factor.
+  float initial_validity = 20.0f;
+  float validity_gain = 5.0f;
+  /// Regularisation: neighbour validity sum below this deletes a pixel; above
+  /// `fill_validity` an empty pixel is filled.
+  float min_neighbour_validity = 24.0f;
+  float fill_validity = 30.0f;
+  /// Seed of the random initialisation.
+  std::uint64_t seed = 1;
+
+  /// Throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+}  // namespace parallax

@@ -1,0 +1,193 @@
+#include "depth/epipolar_search.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace parallax {
+namespace {
+
+constexpr int kPatternHalf = 2;  // 5 samples
+constexpr int kMaxSamples = 256 + 2 * kPatternHalf;
+
+}  // namespace
+
+EpipolarSearch::EpipolarSearch(const Frame& keyframe, const StereoFrame& frame,
+                               const DepthFilterOptions& options)
+    : kf_(keyframe.Level(0)),
+      frame_(frame.frame->Level(0)),
+      fx_(static_cast<float>(keyframe.Camera(0).Fx())),
+      fy_(static_cast<float>(keyframe.Camera(0).Fy())),
+      cx_(static_cast<float>(keyframe.Camera(0).Cx())),
+      cy_(static_cast<float>(keyframe.Camera(0).Cy())),
+      R_(frame.T_frame_kf.RotationMatrix().cast<float>()),
+      t_(frame.T_frame_kf.Translation().cast<float>()),
+      c_kf_(frame.T_frame_kf.Inverse().Translation().cast<float>()),
+      gain_(frame.gain),
+      offset_(frame.offset),
+      line_sigma_sq_(options.epipolar_line_sigma * (1.0f + frame.tracking_quality_penalty) *
+                     options.epipolar_line_sigma * (1.0f + frame.tracking_quality_penalty)),
+      options_(options) {}
+
+StereoObservation EpipolarSearch::Observe(int x, int y, float min_idepth, float max_idepth,
+                                          float expected_idepth, float max_length) const {
+  StereoObservation out;
+  const float w = static_cast<float>(frame_.Width()), h = static_cast<float>(frame_.Height());
+  const Eigen::Vector3f q((static_cast<float>(x) - cx_) / fx_, (static_cast<float>(y) - cy_) / fy_,
+                          1.0f);
+  // Epipolar direction in the keyframe image (towards/away from the frame centre's image).
+  Eigen::Vector2f line_kf(fx_ * (q.x() * c_kf_.z() - c_kf_.x()),
+                          fy_ * (q.y() * c_kf_.z() - c_kf_.y()));
+  if (line_kf.squaredNorm() < 1e-12f) return out;
+  line_kf.normalize();
+  const float gx = kf_.dx(x, y), gy = kf_.dy(x, y);
+  const float g_line = gx * line_kf.x() + gy * line_kf.y();
+  const float g_sq = gx * gx + gy * gy;
+  if (g_line * g_line < options_.min_gradient_along_line_sq ||
+      g_line * g_line < options_.min_gradient_along_line_share * g_sq) {
+    return out;  // gradient (almost) perpendicular to the line: no depth information
+  }
+  // The search segment: projections of the ray at min and max inverse depth.
+  const Eigen::Vector3f Rq = R_ * q;
+  const auto project = [&](float d) -> Eigen::Vector2f {
+    const Eigen::Vector3f p = Rq + d * t_;  // = d * point
+    return {fx_ * p.x() / p.z() + cx_, fy_ * p.y() / p.z() + cy_};
+  };
+  if (t_.z() < 0.0f) max_idepth = std::min(max_idepth, -0.99f * Rq.z() / t_.z());  // stay in front
+  if (!(Rq.z() + min_idepth * t_.z() > 0.0f) || !(max_idepth > min_idepth)) {
+    out.status = StereoStatus::kOutOfImage;
+    return out;
+  }
+  Eigen::Vector2f far = project(min_idepth), near = project(max_idepth);
+  Eigen::Vector2f dir = near - far;
+  float length = dir.norm();
+  if (length < 1e-4f) {
+    dir = Eigen::Vector2f(line_kf);  // no parallax: any direction, one position
+    length = 0.0f;
+  } else {
+    dir /= length;
+  }
+  // Clip [far, near] to the part of the frame where the 5-sample pattern fits.
+  const float lo = 2.0f + kPatternHalf, hi_x = w - 3.0f - kPatternHalf,
+              hi_y = h - 3.0f - kPatternHalf;
+  float s0 = 0.0f, s1 = length;
+  for (int axis = 0; axis < 2; ++axis) {
+    const float p0 = far[axis], d = dir[axis], hi = axis == 0 ? hi_x : hi_y;
+    if (std::abs(d) < 1e-9f) {
+      if (p0 < lo || p0 > hi) s1 = -1.0f;
+      continue;
+    }
+    float a = (lo - p0) / d, b = (hi - p0) / d;
+    if (a > b) std::swap(a, b);
+    s0 = std::max(s0, a);
+    s1 = std::min(s1, b);
+  }
+  if (s1 < s0) {
+    out.status = StereoStatus::kOutOfImage;
+    return out;
+  }
+  // Centre a capped window on the expected inverse depth.
+  if (s1 - s0 > max_length) {
+    const Eigen::Vector2f expected = project(expected_idepth);
+    const float centre =
+        std::clamp((expected - far).dot(dir), s0 + 0.5f * max_length, s1 - 0.5f * max_length);
+    s0 = centre - 0.5f * max_length;
+    s1 = centre + 0.5f * max_length;
+  }
+  // Comparison pattern: 5 keyframe samples along the line, ordered and spaced so that they
+  // map onto 1-pixel steps along the frame's line at the expected depth.
+  const Eigen::Vector2f x_kf(static_cast<float>(x), static_cast<float>(y));
+  const auto point_at = [&](const Eigen::Vector2f& uv, float d) -> Eigen::Vector2f {
+    const Eigen::Vector3f qq((uv.x() - cx_) / fx_, (uv.y() - cy_) / fy_, 1.0f);
+    const Eigen::Vector3f p = R_ * qq + d * t_;
+    return {fx_ * p.x() / p.z() + cx_, fy_ * p.y() / p.z() + cy_};
+  };
+  const Eigen::Vector2f span =
+      point_at(x_kf + line_kf, expected_idepth) - point_at(x_kf - line_kf, expected_idepth);
+  const float rescale = 0.5f * span.norm();
+  if (rescale < options_.min_rescale || rescale > options_.max_rescale) return out;
+  const Eigen::Vector2f step_kf = (span.dot(dir) >= 0.0f ? 1.0f : -1.0f) * line_kf / rescale;
+  std::array<float, 2 * kPatternHalf + 1> pattern{};
+  for (int k = -kPatternHalf; k <= kPatternHalf; ++k) {
+    const Eigen::Vector2f p = x_kf + static_cast<float>(k) * step_kf;
+    pattern[static_cast<std::size_t>(k + kPatternHalf)] =
+        gain_ * InterpolateBilinear(kf_.intensity, p.x(), p.y()) + offset_;
+  }
+  // Frame samples along the segment at 1-pixel steps, with the pattern's margin.
+  const int positions = static_cast<int>(std::floor(s1 - s0)) + 1;
+  const int num_samples = std::min(positions + 2 * kPatternHalf, kMaxSamples);
+  std::array<float, kMaxSamples> samples{};
+  for (int j = 0; j < num_samples; ++j) {
+    const Eigen::Vector2f p = far + (s0 + static_cast<float>(j - kPatternHalf)) * dir;
+    samples[static_cast<std::size_t>(j)] = InterpolateBilinear(frame_.intensity, p.x(), p.y());
+  }
+  const int num_positions = num_samples - 2 * kPatternHalf;
+  std::array<float, kMaxSamples> ssd{};
+  int best = -1;
+  for (int j = 0; j < num_positions; ++j) {
+    float e = 0.0f;
+    for (int k = 0; k <= 2 * kPatternHalf; ++k) {
+      const float diff =
+          samples[static_cast<std::size_t>(j + k)] - pattern[static_cast<std::size_t>(k)];
+      e += diff * diff;
+    }
+    ssd[static_cast<std::size_t>(j)] = e;
+    if (best < 0 || e < ssd[static_cast<std::size_t>(best)]) best = j;
+  }
+  out.search_length = s1 - s0;
+  const float best_ssd = ssd[static_cast<std::size_t>(best)];
+  // Frame gradient along the line over the matched pattern (for the photometric error).
+  float g_frame_sq = 0.0f;
+  for (int k = 1; k < 2 * kPatternHalf; ++k) {
+    const float g = 0.5f * (samples[static_cast<std::size_t>(best + k + 1)] -
+                            samples[static_cast<std::size_t>(best + k - 1)]);
+    g_frame_sq += g * g / (2 * kPatternHalf - 1);
+  }
+  if (best_ssd > options_.max_ssd + 20.0f * std::sqrt(g_frame_sq * (2 * kPatternHalf + 1))) {
+    out.status = StereoStatus::kNoMatch;
+    return out;
+  }
+  for (int j = 0; j < num_positions; ++j) {
+    if (std::abs(j - best) > 1 &&
+        ssd[static_cast<std::size_t>(j)] < options_.ambiguity_ratio * best_ssd) {
+      out.status = StereoStatus::kAmbiguous;
+      return out;
+    }
+  }
+  // Sub-pixel: vertex of the parabola through the SSD at best - 1, best, best + 1.
+  float offset_px = 0.0f;
+  if (best > 0 && best + 1 < num_positions) {
+    const float a = ssd[static_cast<std::size_t>(best - 1)], b = best_ssd,
+                c = ssd[static_cast<std::size_t>(best + 1)];
+    const float denom = a - 2.0f * b + c;
+    if (denom > 1e-6f) offset_px = std::clamp(0.5f * (a - c) / denom, -0.5f, 0.5f);
+  }
+  const Eigen::Vector2f match = far + (s0 + static_cast<float>(best) + offset_px) * dir;
+  // Inverse depth of the match: pi(Rq + d t) = match, solved on the better-conditioned axis.
+  const auto idepth_at = [&](const Eigen::Vector2f& m) {
+    if (std::abs(dir.x()) >= std::abs(dir.y())) {
+      const float n = (m.x() - cx_) / fx_;
+      return (n * Rq.z() - Rq.x()) / (t_.x() - n * t_.z());
+    }
+    const float n = (m.y() - cy_) / fy_;
+    return (n * Rq.z() - Rq.y()) / (t_.y() - n * t_.z());
+  };
+  const float d = idepth_at(match);
+  const float alpha =
+      std::abs(idepth_at(match + 0.5f * dir) - idepth_at(match - 0.5f * dir));  // per pixel
+  if (!(d > 0.0f) || !std::isfinite(d) || !std::isfinite(alpha) || d > options_.max_idepth) {
+    out.status = StereoStatus::kOutOfImage;
+    return out;
+  }
+  // Disparity variance: epipolar line error projected on the gradient, image noise over the
+  // gradient along the line, and sub-pixel discretisation (docs/math/depth_filter.md).
+  const float geometric = line_sigma_sq_ * g_sq / (g_line * g_line);
+  const float photometric =
+      2.0f * options_.pixel_noise_sigma * options_.pixel_noise_sigma / std::max(g_frame_sq, 1.0f);
+  out.status = StereoStatus::kOk;
+  out.idepth = d;
+  out.variance = alpha * alpha * (geometric + photometric + 0.05f);
+  return out;
+}
+
+}  // namespace parallax

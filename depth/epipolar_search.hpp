@@ -1,0 +1,62 @@
+#pragma once
+// Stereo observation of one keyframe pixel's inverse depth along its epipolar line in another
+// frame of known relative pose (docs/math/depth_filter.md).
+
+#include <Eigen/Core>
+
+#include "core/frame.hpp"
+#include "core/se3.hpp"
+#include "depth/depth_options.hpp"
+
+namespace parallax {
+
+/// A tracked frame as seen from a keyframe: image, relative pose, brightness, pose quality.
+struct StereoFrame {
+  const Frame* frame = nullptr;
+  SE3d T_frame_kf;    ///< keyframe -> frame
+  float gain = 1.0f;  ///< I_frame ~= gain * I_kf + offset
+  float offset = 0.0f;
+  /// Extra epipolar-line uncertainty from tracking, multiplies the line sigma as (1 + q).
+  float tracking_quality_penalty = 0.0f;
+};
+
+enum class StereoStatus {
+  kOk,
+  kSkipped,     ///< gradient not along the epipolar line, or pattern rescaled too much
+  kOutOfImage,  ///< no part of the search segment is inside the frame
+  kNoMatch,     ///< best SSD above the threshold
+  kAmbiguous,   ///< a non-adjacent candidate almost as good as the best
+};
+
+struct StereoObservation {
+  StereoStatus status = StereoStatus::kSkipped;
+  float idepth = 0.0f;
+  float variance = 0.0f;
+  float search_length = 0.0f;  ///< pixels searched
+};
+
+/// Precomputed per (keyframe, frame) pair; cheap to copy.
+class EpipolarSearch {
+ public:
+  EpipolarSearch(const Frame& keyframe, const StereoFrame& frame,
+                 const DepthFilterOptions& options);
+
+  /// Searches keyframe pixel (x, y) for inverse depths in [min_idepth, max_idepth] (the prior
+  /// mu +- 2 sigma, or the full range for a new pixel); `expected_idepth` (> 0) orients and
+  /// scales the comparison pattern, and `max_length` caps the searched segment (pixels).
+  StereoObservation Observe(int x, int y, float min_idepth, float max_idepth, float expected_idepth,
+                            float max_length) const;
+
+ private:
+  const PyramidLevel& kf_;
+  const PyramidLevel& frame_;
+  float fx_, fy_, cx_, cy_;
+  Eigen::Matrix3f R_;  // frame <- kf
+  Eigen::Vector3f t_;
+  Eigen::Vector3f c_kf_;  // frame centre in keyframe coordinates
+  float gain_, offset_;
+  float line_sigma_sq_;
+  DepthFilterOptions options_;
+};
+
+}  // namespace parallax
