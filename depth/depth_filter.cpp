@@ -128,16 +128,16 @@ DepthUpdateStats DepthFilter::Update(InverseDepthMap* map, const StereoFrame& fr
 void DepthFilter::Regularize(InverseDepthMap* map) const {
   const int w = map->Width(), h = map->Height();
   std::vector<std::uint8_t> keep(map->valid.size(), 0);
-  tbb::parallel_for(0, h, [&](int y) {
-    for (int x = 0; x < w; ++x) {
+  // Valid pixels are eligible ones, which keep a 3-pixel border: the 5x5 window needs no
+  // bounds checks.
+  tbb::parallel_for(2, h - 2, [&](int y) {
+    for (int x = 2; x < w - 2; ++x) {
       const std::size_t i = map->Index(x, y);
       if (!map->valid[i]) continue;
       double sum_w = 0.0, sum_wd = 0.0, support = 0.0, agree = 0.0, disagree = 0.0;
       for (int dy = -2; dy <= 2; ++dy) {
         for (int dx = -2; dx <= 2; ++dx) {
-          const int nx = x + dx, ny = y + dy;
-          if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
-          const std::size_t j = map->Index(nx, ny);
+          const std::size_t j = map->Index(x + dx, y + dy);
           if (!map->valid[j]) continue;
           support += map->validity[j];
           const float diff = map->idepth[j] - map->idepth[i];

@@ -22,6 +22,7 @@ void DepthFilterOptions::Check() const {
   CheckOption(max_ssd > 0.0f, s, "max_ssd", "must be > 0");
   CheckOption(ambiguity_ratio >= 1.0f, s, "ambiguity_ratio", "must be >= 1");
   CheckOption(max_search_length >= 3.0f, s, "max_search_length", "must be >= 3");
+  CheckOption(max_search_length_new >= 3.0f, s, "max_search_length_new", "must be >= 3");
   CheckOption(min_rescale > 0.0f && max_rescale > min_rescale, s, "min_rescale/max_rescale",
               "need 0 < min < max");
 }

@@ -30,8 +30,11 @@ struct DepthFilterOptions {
   float max_ssd = 1300.0f;
   /// Ambiguous when a non-adjacent runner-up is below this factor times the best SSD.
   float ambiguity_ratio = 1.5f;
-  /// Longest searched epipolar segment, pixels.
+  /// Longest searched epipolar segment for a pixel with a prior, pixels.
   float max_search_length = 30.0f;
+  /// Longest segment of the full-range search for a new pixel, pixels (centred on the
+  /// geometric mean of min/max inverse depth).
+  float max_search_length_new = 60.0f;
   /// Gates: squared gradient along the epipolar line >= this, and its share of |grad|^2.
   float min_gradient_along_line_sq = 4.0f;
   float min_gradient_along_line_share = 0.09f;
