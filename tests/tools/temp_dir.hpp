@@ -2,6 +2,7 @@
 // A temporary folder removed at the end of a test.
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -32,6 +33,23 @@ class TempDir {
     std::ofstream(file) << text;
     return file.string();
   }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// A named temporary folder for suite-level fixtures (TempDir needs a running test).
+class TempDirAt {
+ public:
+  explicit TempDirAt(const std::string& name)
+      : path_(std::filesystem::temp_directory_path() / (name + "_" + std::to_string(::getpid()))) {
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDirAt() { std::filesystem::remove_all(path_); }
+  TempDirAt(const TempDirAt&) = delete;
+  TempDirAt& operator=(const TempDirAt&) = delete;
+  std::string File(const std::string& name) const { return (path_ / name).string(); }
 
  private:
   std::filesystem::path path_;

@@ -1,0 +1,110 @@
+#pragma once
+// The visual-odometry pipeline (deterministic mode): tracking against the current keyframe,
+// depth updates, keyframe creation with propagation and scale normalisation.
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "core/frame.hpp"
+#include "core/image.hpp"
+#include "core/pinhole_camera.hpp"
+#include "core/sim3.hpp"
+#include "depth/depth_filter.hpp"
+#include "tracking/se3_tracker.hpp"
+#include "tracking/tracking_reference.hpp"
+
+namespace parallax {
+
+struct SystemOptions {
+  PyramidOptions pyramid;
+  TrackingReferenceOptions reference;
+  Se3TrackerOptions tracker;
+  DepthFilterOptions depth;
+  /// New keyframe when |t_kf_frame| * mean idepth (distance relative to the mean depth)
+  /// exceeds this, or when fewer than `min_keyframe_usage` of the keyframe points are in view.
+  double keyframe_distance = 0.15;
+  double min_keyframe_usage = 0.6;
+  /// No depth update when the baseline relative to the mean depth is below this (static
+  /// camera or pure rotation: no parallax, nothing to learn).
+  double min_update_baseline = 0.004;
+  /// Frames tracked into a keyframe before it may be replaced.
+  int min_frames_per_keyframe = 3;
+  /// The random start counts as initialised after this many depth updates of the first
+  /// keyframe; the frames tracked before that are then tracked again against the converged
+  /// depth and their poses revised (design.md section 3a).
+  int initialization_updates = 30;
+
+  void Check() const;
+};
+
+/// A corrected pose of an earlier frame.
+struct RevisedPose {
+  std::int64_t frame_id = 0;
+  double timestamp = 0.0;
+  SE3d T_w_c;
+};
+
+/// Per-frame outcome.
+struct FrameResult {
+  TrackingStatus status = TrackingStatus::kLost;
+  /// Camera-to-world pose (world = first keyframe, its scale); empty when lost.
+  std::optional<SE3d> T_w_c;
+  bool is_keyframe = false;
+  TrackingStats stats;
+  double tracking_ms = 0.0;  ///< wall time of tracking this frame
+  double mapping_ms = 0.0;   ///< depth update and keyframe creation
+  /// Earlier frames re-tracked when initialisation completed (empty otherwise).
+  std::vector<RevisedPose> revised;
+};
+
+/// A finished or current keyframe as the outputs need it.
+struct KeyframeRecord {
+  std::int64_t frame_id = 0;
+  double timestamp = 0.0;
+  Sim3d S_w_kf;  ///< keyframe-to-world similarity (scale: the keyframe's normalised depth)
+};
+
+/// Runs tracking and mapping for each frame in order (deterministic). Owns no threads yet;
+/// the real-time mode will split tracking and mapping behind the same interface.
+class System {
+ public:
+  /// `camera` is the ideal pinhole camera of the (already undistorted) images.
+  System(const PinholeCamera& camera, const SystemOptions& options = {});
+
+  /// Processes one undistorted 8-bit image. Throws std::invalid_argument for a wrong size.
+  FrameResult ProcessFrame(const ImageU8& image, double timestamp);
+
+  const std::vector<KeyframeRecord>& Keyframes() const { return keyframes_; }
+  /// Semi-dense points of all keyframes (world coordinates), confirmed estimates only.
+  std::vector<Eigen::Vector3f> MapPoints() const;
+  int FramesProcessed() const { return frame_count_; }
+  /// Index of the frame at which initialisation completed; -1 while initialising.
+  int InitialisedAtFrame() const { return initialised_at_frame_; }
+
+ private:
+  void StartKeyframe(std::shared_ptr<const Frame> frame, const Sim3d& S_w_kf, InverseDepthMap map);
+  void RebuildReference();
+  std::vector<RevisedPose> FinishInitialisation();
+
+  PinholeCamera camera_;
+  SystemOptions options_;
+  Se3Tracker tracker_;
+  DepthFilter depth_filter_;
+  std::unique_ptr<InverseDepthMap> map_;
+  std::unique_ptr<TrackingReference> reference_;
+  std::vector<KeyframeRecord> keyframes_;
+  std::vector<std::vector<Eigen::Vector3f>> finished_points_;
+  Sim3d S_w_kf_;
+  SE3d T_kf_last_;
+  SE3d T_prev_last_;  ///< last inter-frame motion (for the constant-velocity guess)
+  AffineBrightness affine_;
+  int frames_in_keyframe_ = 0;
+  int frame_count_ = 0;
+  int depth_updates_ = 0;
+  int initialised_at_frame_ = -1;
+  std::vector<std::pair<std::shared_ptr<const Frame>, SE3d>>
+      initial_frames_;  ///< frame, T_kf_frame
+};
+
+}  // namespace parallax

@@ -1,0 +1,42 @@
+// parallax run <dataset> [--format F] [--calib FILE] [--out DIR] [--max-frames N]
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cstdio>
+
+#include "tools/commands/commands.hpp"
+#include "tools/run_pipeline.hpp"
+
+namespace parallax::cli {
+
+void AddRunCommand(CLI::App& app, int* exit_code) {
+  auto options = std::make_shared<RunOptions>();
+  auto format = std::make_shared<std::string>("auto");
+  auto realtime = std::make_shared<bool>(false);
+  CLI::App* cmd = app.add_subcommand("run", "Run visual odometry on a dataset");
+  cmd->add_option("dataset", options->dataset, "dataset folder or video file")->required();
+  cmd->add_option("--format", *format, "auto|tum|monovo|euroc|kitti|images|video");
+  cmd->add_option("--calib", options->dataset_options.calibration_file,
+                  "calibration YAML (docs/calibration.md)");
+  cmd->add_option("--out", options->out_dir, "output folder (created)");
+  cmd->add_option("--max-frames", options->max_frames, "stop after N frames (0: all)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--realtime", *realtime, "threaded real-time mode (not implemented yet)");
+  cmd->callback([options, format, realtime, exit_code] {
+    if (*realtime)
+      throw std::invalid_argument("--realtime is not implemented yet; the deterministic mode runs");
+    options->dataset_options.format = DatasetFormatFromString(*format);
+    options->progress = isatty(STDERR_FILENO) != 0;
+    const RunSummary s = RunDataset(*options);
+    std::printf(
+        "%s", fmt::format(
+                  "{} frames, {} tracked ({:.1f}%), {} keyframes, {:.1f} frames/s; outputs in {}\n",
+                  s.frames, s.frames_tracked, 100.0 * s.frames_tracked / s.frames, s.keyframes,
+                  s.fps, options->out_dir)
+                  .c_str());
+    *exit_code = 0;
+  });
+}
+
+}  // namespace parallax::cli

@@ -1,0 +1,125 @@
+#include "tools/run_pipeline.hpp"
+
+#include <fmt/format.h>
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "core/check.hpp"
+#include "core/undistorter.hpp"
+#include "tools/dataset/input_error.hpp"
+#include "tools/dataset/trajectory.hpp"
+
+namespace parallax {
+namespace {
+
+double Percentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  return values[static_cast<std::size_t>(q * static_cast<double>(values.size() - 1) + 0.5)];
+}
+
+void WritePly(const std::string& path, const std::vector<Eigen::Vector3f>& points) {
+  std::ofstream out(path);
+  if (!out) throw InputError(path, "cannot open for writing");
+  out << "ply\nformat ascii 1.0\nelement vertex " << points.size()
+      << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  for (const Eigen::Vector3f& p : points)
+    out << fmt::format("{:.5f} {:.5f} {:.5f}\n", p.x(), p.y(), p.z());
+  if (!out) throw InputError(path, "write failed");
+}
+
+void WriteStats(const std::string& path, const RunSummary& s) {
+  const nlohmann::json j = {
+      {"frames", s.frames},
+      {"frames_tracked", s.frames_tracked},
+      {"keyframes", s.keyframes},
+      {"loop_closures", 0},
+      {"relocalisations", 0},
+      {"initialised_at_frame", s.initialised_at_frame},
+      {"wall_s", s.wall_s},
+      {"fps", s.fps},
+      {"tracking_ms", {{"p50", s.tracking_ms_p50}, {"p95", s.tracking_ms_p95}}},
+      {"mapping_ms", {{"p50", s.mapping_ms_p50}, {"p95", s.mapping_ms_p95}}},
+      {"map_points", s.map_points},
+      {"peak_rss_mb", s.peak_rss_mb}};
+  std::ofstream out(path);
+  if (!out) throw InputError(path, "cannot open for writing");
+  out << j.dump(2) << "\n";
+}
+
+}  // namespace
+
+RunSummary RunDataset(const RunOptions& options) {
+  CheckArgument(options.max_frames >= 0, "--max-frames must be >= 0");
+  const auto reader = OpenDataset(options.dataset, options.dataset_options);
+  const Undistorter undistorter(reader->GetCamera(), reader->SuggestedRectification());
+  System system(undistorter.OutputCamera(), options.system);
+  std::error_code ec;
+  std::filesystem::create_directories(options.out_dir, ec);
+  if (!std::filesystem::is_directory(options.out_dir)) {
+    throw InputError(options.out_dir, "cannot create the output folder");
+  }
+  std::vector<std::optional<StampedPose>> poses;  // by frame index; revisions overwrite
+  std::vector<double> tracking_ms, mapping_ms;
+  RunSummary summary;
+  ImageU8 rectified;
+  const auto start = std::chrono::steady_clock::now();
+  while (options.max_frames == 0 || summary.frames < options.max_frames) {
+    const auto frame = reader->Next();
+    if (!frame) break;
+    undistorter.Apply(frame->image, &rectified);
+    const FrameResult result = system.ProcessFrame(rectified, frame->timestamp);
+    ++summary.frames;
+    summary.frames_tracked += result.T_w_c.has_value();
+    poses.emplace_back();
+    if (result.T_w_c) poses.back() = StampedPose{frame->timestamp, *result.T_w_c};
+    for (const RevisedPose& r : result.revised) {
+      poses[static_cast<std::size_t>(r.frame_id)] = StampedPose{r.timestamp, r.T_w_c};
+    }
+    tracking_ms.push_back(result.tracking_ms);
+    mapping_ms.push_back(result.mapping_ms);
+    if (options.progress) {
+      std::fprintf(stderr, "\rframe %d/%zu  tracked %d  keyframes %zu  %s   ", summary.frames,
+                   reader->NumFrames(), summary.frames_tracked, system.Keyframes().size(),
+                   ToString(result.status).c_str());
+    }
+  }
+  if (options.progress) std::fprintf(stderr, "\n");
+  if (summary.frames == 0) throw InputError(options.dataset, "has no frames");
+  Trajectory trajectory;
+  for (const auto& pose : poses) {
+    if (pose) trajectory.push_back(*pose);
+  }
+  summary.frames_tracked = static_cast<int>(trajectory.size());
+  summary.initialised_at_frame = system.InitialisedAtFrame();
+  summary.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.fps = summary.frames / std::max(summary.wall_s, 1e-9);
+  summary.keyframes = static_cast<int>(system.Keyframes().size());
+  summary.tracking_ms_p50 = Percentile(tracking_ms, 0.5);
+  summary.tracking_ms_p95 = Percentile(tracking_ms, 0.95);
+  summary.mapping_ms_p50 = Percentile(mapping_ms, 0.5);
+  summary.mapping_ms_p95 = Percentile(mapping_ms, 0.95);
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  summary.peak_rss_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;
+  const std::filesystem::path out(options.out_dir);
+  WriteTumTrajectory((out / "trajectory.txt").string(), trajectory);
+  Trajectory keyframes;
+  for (const KeyframeRecord& kf : system.Keyframes()) {
+    keyframes.push_back({kf.timestamp, SE3d(kf.S_w_kf.Rotation(), kf.S_w_kf.Translation())});
+  }
+  WriteTumTrajectory((out / "keyframes.txt").string(), keyframes);
+  const auto points = system.MapPoints();
+  summary.map_points = points.size();
+  WritePly((out / "map.ply").string(), points);
+  WriteStats((out / "stats.json").string(), summary);
+  return summary;
+}
+
+}  // namespace parallax

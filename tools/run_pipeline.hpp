@@ -1,0 +1,39 @@
+#pragma once
+// Running the pipeline over a dataset and writing its outputs (design.md section 5).
+
+#include <optional>
+#include <string>
+
+#include "backend/system.hpp"
+#include "tools/dataset/dataset_reader.hpp"
+
+namespace parallax {
+
+struct RunOptions {
+  std::string dataset;
+  DatasetOptions dataset_options;
+  std::string out_dir = "parallax_out";
+  int max_frames = 0;  ///< 0: all
+  SystemOptions system;
+  bool progress = false;  ///< a progress line on stderr
+};
+
+struct RunSummary {
+  int frames = 0;
+  int frames_tracked = 0;
+  int keyframes = 0;
+  double wall_s = 0.0;
+  double fps = 0.0;
+  double tracking_ms_p50 = 0.0, tracking_ms_p95 = 0.0;
+  double mapping_ms_p50 = 0.0, mapping_ms_p95 = 0.0;
+  double peak_rss_mb = 0.0;
+  std::size_t map_points = 0;
+  int initialised_at_frame = -1;  ///< -1: never initialised
+};
+
+/// Reads the dataset, rectifies each image, runs System::ProcessFrame, and writes
+/// out_dir/{trajectory.txt, keyframes.txt, map.ply, stats.json}. Throws InputError for bad
+/// input (naming the file) and std::invalid_argument for bad options.
+RunSummary RunDataset(const RunOptions& options);
+
+}  // namespace parallax
