@@ -155,6 +155,7 @@ TEST_F(DepthFilterTest, PropagationKeepsVisiblePoints) {
     }
   }
   ASSERT_GT(visible, 10000);
+  RecordProperty("kept_of_visible", std::to_string(static_cast<double>(kept) / visible));
   EXPECT_GE(static_cast<double>(kept) / visible, 0.8) << "kept " << kept << " of " << visible;
   // Error not worse than the 2% prior (exact pose): median within 1%.
   const ErrorSummary s = Summarize(propagated, next.idepth);
@@ -249,6 +250,7 @@ TEST_F(DepthFilterTest, OccluderDoesNotCorruptBackground) {
   ASSERT_GT(hidden_total, 2000);
   RecordProperty("hidden_pixels", hidden_total);
   RecordProperty("hidden_still_valid", hidden_valid);
+  RecordProperty("hidden_corrupted", corrupted);
   EXPECT_LE(corrupted, hidden_total / 50)
       << corrupted << " of " << hidden_total << " background pixels corrupted";
 }
