@@ -108,7 +108,8 @@ FrameResult System::ProcessFrame(const ImageU8& image, double timestamp) {
       tracked.T_kf_frame.Translation().norm() * map_->MeanSmoothedIdepth();
   const bool want_keyframe = frames_in_keyframe_ >= options_.min_frames_per_keyframe &&
                              (relative_distance > options_.keyframe_distance ||
-                              tracked.stats.usage < options_.min_keyframe_usage);
+                              tracked.stats.usage < options_.min_keyframe_usage ||
+                              tracked.stats.good_ratio < options_.min_keyframe_good_ratio);
   if (tracked.status == TrackingStatus::kOk && relative_distance > options_.min_update_baseline) {
     const StereoFrame stereo{frame.get(), tracked.T_kf_frame.Inverse(), tracked.affine.Gain(),
                              tracked.affine.b, static_cast<float>(1.0 - tracked.stats.good_ratio)};
@@ -123,7 +124,7 @@ FrameResult System::ProcessFrame(const ImageU8& image, double timestamp) {
       result.revised = FinishInitialisation();
     }
   }
-  if (want_keyframe && tracked.status == TrackingStatus::kOk) {
+  if (want_keyframe) {  // ok or poor: a degrading view is the reason to switch
     InverseDepthMap next = depth_filter_.Propagate(*map_, frame, tracked.T_kf_frame.Inverse(),
                                                    tracked.affine.Gain(), tracked.affine.b);
     const float s = depth_filter_.NormalizeScale(&next);

@@ -25,6 +25,9 @@ struct SystemOptions {
   /// exceeds this, or when fewer than `min_keyframe_usage` of the keyframe points are in view.
   double keyframe_distance = 0.15;
   double min_keyframe_usage = 0.6;
+  /// ... or when the share of consistent points falls below this (the view has changed
+  /// enough that the keyframe explains it worse; DSO uses a residual-growth rule alike).
+  double min_keyframe_good_ratio = 0.75;
   /// No depth update when the baseline relative to the mean depth is below this (static
   /// camera or pure rotation: no parallax, nothing to learn).
   double min_update_baseline = 0.004;
