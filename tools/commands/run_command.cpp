@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "tools/commands/commands.hpp"
+#include "tools/config_yaml.hpp"
 #include "tools/run_pipeline.hpp"
 
 namespace parallax::cli {
@@ -14,6 +15,7 @@ void AddRunCommand(CLI::App& app, int* exit_code) {
   auto options = std::make_shared<RunOptions>();
   auto format = std::make_shared<std::string>("auto");
   auto realtime = std::make_shared<bool>(false);
+  auto config = std::make_shared<std::string>();
   CLI::App* cmd = app.add_subcommand("run", "Run visual odometry on a dataset");
   cmd->add_option("dataset", options->dataset, "dataset folder or video file")->required();
   cmd->add_option("--format", *format, "auto|tum|monovo|euroc|kitti|images|video");
@@ -22,6 +24,7 @@ void AddRunCommand(CLI::App& app, int* exit_code) {
   cmd->add_option("--out", options->out_dir, "output folder (created)");
   cmd->add_option("--max-frames", options->max_frames, "stop after N frames (0: all)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--config", *config, "pipeline options, YAML (docs/configuration.md)");
   cmd->add_flag("--realtime", *realtime, "threaded real-time mode (not implemented yet)");
   cmd->callback([options, format, realtime, exit_code] {
     if (*realtime)

@@ -1,0 +1,105 @@
+#include "tools/config_yaml.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <functional>
+#include <map>
+
+#include "tools/dataset/input_error.hpp"
+
+namespace parallax {
+namespace {
+
+using Setter = std::function<void(const YAML::Node&)>;
+using Section = std::map<std::string, Setter>;
+
+int LineOf(const YAML::Node& node) { return node.Mark().line >= 0 ? node.Mark().line + 1 : 0; }
+
+template <typename T>
+Setter Set(T* field) {
+  return [field](const YAML::Node& node) { *field = node.as<T>(); };
+}
+
+std::map<std::string, Section> Sections(SystemOptions* o) {
+  return {
+      {"pyramid",
+       {{"max_levels", Set(&o->pyramid.max_levels)},
+        {"min_level_size", Set(&o->pyramid.min_level_size)}}},
+      {"reference", {{"min_gradient", Set(&o->reference.min_gradient)}}},
+      {"tracker",
+       {{"finest_level", Set(&o->tracker.finest_level)},
+        {"max_iterations", Set(&o->tracker.max_iterations)},
+        {"pixel_noise_sigma", Set(&o->tracker.pixel_noise_sigma)},
+        {"huber_threshold", Set(&o->tracker.huber_threshold)},
+        {"estimate_affine", Set(&o->tracker.estimate_affine)},
+        {"affine_prior_a", Set(&o->tracker.affine_prior_a)},
+        {"affine_prior_b", Set(&o->tracker.affine_prior_b)},
+        {"good_threshold", Set(&o->tracker.good_threshold)},
+        {"min_good_ratio_ok", Set(&o->tracker.min_good_ratio_ok)},
+        {"min_good_ratio_poor", Set(&o->tracker.min_good_ratio_poor)}}},
+      {"depth",
+       {{"min_gradient", Set(&o->depth.min_gradient)},
+        {"pixel_noise_sigma", Set(&o->depth.pixel_noise_sigma)},
+        {"max_search_length", Set(&o->depth.max_search_length)},
+        {"max_search_length_new", Set(&o->depth.max_search_length_new)},
+        {"max_variance", Set(&o->depth.max_variance)},
+        {"seed", Set(&o->depth.seed)}}},
+      {"system",
+       {{"keyframe_distance", Set(&o->keyframe_distance)},
+        {"min_keyframe_usage", Set(&o->min_keyframe_usage)},
+        {"min_keyframe_good_ratio", Set(&o->min_keyframe_good_ratio)},
+        {"min_update_baseline", Set(&o->min_update_baseline)},
+        {"min_frames_per_keyframe", Set(&o->min_frames_per_keyframe)},
+        {"initialization_updates", Set(&o->initialization_updates)}}},
+  };
+}
+
+}  // namespace
+
+void ApplyConfigYaml(const std::string& path, SystemOptions* options) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "cannot open configuration file");
+  YAML::Node root;
+  try {
+    root = YAML::Load(in);
+  } catch (const YAML::ParserException& e) {
+    throw InputError(path, e.mark.line + 1, "YAML syntax error: " + e.msg);
+  }
+  if (root.IsNull()) return;  // empty file: defaults
+  if (!root.IsMap()) throw InputError(path, "configuration must be a YAML mapping of sections");
+  SystemOptions updated = *options;
+  auto sections = Sections(&updated);
+  for (const auto& section : root) {
+    const std::string name = section.first.as<std::string>();
+    const auto found = sections.find(name);
+    if (found == sections.end()) {
+      throw InputError(
+          path, LineOf(section.first),
+          "unknown section '" + name + "' (expected pyramid, reference, tracker, depth or system)");
+    }
+    if (!section.second.IsMap())
+      throw InputError(path, LineOf(section.second), "section '" + name + "' must be a mapping");
+    for (const auto& entry : section.second) {
+      const std::string key = entry.first.as<std::string>();
+      const auto setter = found->second.find(key);
+      if (setter == found->second.end()) {
+        throw InputError(path, LineOf(entry.first), "unknown key '" + name + "." + key + "'");
+      }
+      try {
+        setter->second(entry.second);
+      } catch (const YAML::Exception&) {
+        throw InputError(path, LineOf(entry.second),
+                         "'" + name + "." + key + "' has a value of the wrong type");
+      }
+    }
+  }
+  try {
+    updated.Check();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(path, e.what());
+  }
+  *options = updated;
+}
+
+}  // namespace parallax
