@@ -49,7 +49,7 @@ void System::RebuildReference() {
                                                    options_.reference);
 }
 
-void System::StartKeyframe(std::shared_ptr<const Frame> frame, const Sim3d& S_w_kf,
+void System::StartKeyframe(const std::shared_ptr<const Frame>& frame, const Sim3d& S_w_kf,
                            InverseDepthMap map) {
   if (map_) finished_points_.push_back(WorldPoints(*map_, S_w_kf_));
   map_ = std::make_unique<InverseDepthMap>(std::move(map));

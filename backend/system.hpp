@@ -73,7 +73,7 @@ struct KeyframeRecord {
 class System {
  public:
   /// `camera` is the ideal pinhole camera of the (already undistorted) images.
-  System(const PinholeCamera& camera, const SystemOptions& options = {});
+  explicit System(const PinholeCamera& camera, const SystemOptions& options = {});
 
   /// Processes one undistorted 8-bit image. Throws std::invalid_argument for a wrong size.
   FrameResult ProcessFrame(const ImageU8& image, double timestamp);
@@ -86,7 +86,8 @@ class System {
   int InitialisedAtFrame() const { return initialised_at_frame_; }
 
  private:
-  void StartKeyframe(std::shared_ptr<const Frame> frame, const Sim3d& S_w_kf, InverseDepthMap map);
+  void StartKeyframe(const std::shared_ptr<const Frame>& frame, const Sim3d& S_w_kf,
+                     InverseDepthMap map);
   void RebuildReference();
   std::vector<RevisedPose> FinishInitialisation();
 

@@ -50,9 +50,9 @@ struct BlockAccumulator {
   int count = 0;
 
   void Add(const Eigen::Matrix<float, N, 1>& J, float r, float w, float robust_cost) {
-    const Eigen::Matrix<float, N, 1> wJ = w * J;
-    H.noalias() += wJ * J.transpose();
-    g.noalias() += r * wJ;
+    const Eigen::Matrix<float, N, 1> w_J = w * J;
+    H.noalias() += w_J * J.transpose();
+    g.noalias() += r * w_J;
     cost += robust_cost;
     ++count;
   }

@@ -51,7 +51,7 @@ class DepthFilter {
   /// variances ((d_new/d_old)^4), resolving collisions (inconsistent: keep the nearer;
   /// consistent: fuse), then regularises and fills holes.
   InverseDepthMap Propagate(const InverseDepthMap& old_map,
-                            std::shared_ptr<const Frame> new_keyframe, const SE3d& T_new_old,
+                            const std::shared_ptr<const Frame>& new_keyframe, const SE3d& T_new_old,
                             float gain = 1.0f, float offset = 0.0f,
                             PropagationStats* stats = nullptr) const;
 

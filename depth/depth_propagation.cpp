@@ -8,7 +8,7 @@
 namespace parallax {
 
 InverseDepthMap DepthFilter::Propagate(const InverseDepthMap& old_map,
-                                       std::shared_ptr<const Frame> new_keyframe,
+                                       const std::shared_ptr<const Frame>& new_keyframe,
                                        const SE3d& T_new_old, float gain, float offset,
                                        PropagationStats* stats) const {
   CheckArgument(new_keyframe != nullptr, "DepthFilter::Propagate: no keyframe");

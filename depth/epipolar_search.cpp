@@ -10,6 +10,9 @@ namespace {
 constexpr int kPatternHalf = 2;  // 5 samples
 constexpr int kMaxSamples = 256 + 2 * kPatternHalf;
 
+// Array index from a (non-negative) int position.
+constexpr std::size_t Idx(int i) { return static_cast<std::size_t>(i); }
+
 }  // namespace
 
 EpipolarSearch::EpipolarSearch(const Frame& keyframe, const StereoFrame& frame,
@@ -110,7 +113,7 @@ StereoObservation EpipolarSearch::Observe(int x, int y, float min_idepth, float 
   std::array<float, 2 * kPatternHalf + 1> pattern{};
   for (int k = -kPatternHalf; k <= kPatternHalf; ++k) {
     const Eigen::Vector2f p = x_kf + static_cast<float>(k) * step_kf;
-    pattern[static_cast<std::size_t>(k + kPatternHalf)] =
+    pattern[Idx(k + kPatternHalf)] =
         gain_ * InterpolateBilinear(kf_.intensity, p.x(), p.y()) + offset_;
   }
   // Frame samples along the segment at 1-pixel steps, with the pattern's margin.
@@ -121,7 +124,7 @@ StereoObservation EpipolarSearch::Observe(int x, int y, float min_idepth, float 
   std::array<float, kMaxSamples> samples;  // NOLINT(cppcoreguidelines-pro-type-member-init)
   for (int j = 0; j < num_samples; ++j) {
     const Eigen::Vector2f p = far + (s0 + static_cast<float>(j - kPatternHalf)) * dir;
-    samples[static_cast<std::size_t>(j)] = InterpolateBilinear(frame_.intensity, p.x(), p.y());
+    samples[Idx(j)] = InterpolateBilinear(frame_.intensity, p.x(), p.y());
   }
   const int num_positions = num_samples - 2 * kPatternHalf;
   std::array<float, kMaxSamples> ssd;  // NOLINT(cppcoreguidelines-pro-type-member-init)
@@ -129,20 +132,18 @@ StereoObservation EpipolarSearch::Observe(int x, int y, float min_idepth, float 
   for (int j = 0; j < num_positions; ++j) {
     float e = 0.0f;
     for (int k = 0; k <= 2 * kPatternHalf; ++k) {
-      const float diff =
-          samples[static_cast<std::size_t>(j + k)] - pattern[static_cast<std::size_t>(k)];
+      const float diff = samples[Idx(j + k)] - pattern[Idx(k)];
       e += diff * diff;
     }
-    ssd[static_cast<std::size_t>(j)] = e;
-    if (best < 0 || e < ssd[static_cast<std::size_t>(best)]) best = j;
+    ssd[Idx(j)] = e;
+    if (best < 0 || e < ssd[Idx(best)]) best = j;
   }
   out.search_length = s1 - s0;
-  const float best_ssd = ssd[static_cast<std::size_t>(best)];
+  const float best_ssd = ssd[Idx(best)];
   // Frame gradient along the line over the matched pattern (for the photometric error).
   float g_frame_sq = 0.0f;
   for (int k = 1; k < 2 * kPatternHalf; ++k) {
-    const float g = 0.5f * (samples[static_cast<std::size_t>(best + k + 1)] -
-                            samples[static_cast<std::size_t>(best + k - 1)]);
+    const float g = 0.5f * (samples[Idx(best + k + 1)] - samples[Idx(best + k - 1)]);
     g_frame_sq += g * g / (2 * kPatternHalf - 1);
   }
   if (best_ssd > options_.max_ssd + 20.0f * std::sqrt(g_frame_sq * (2 * kPatternHalf + 1))) {
@@ -150,8 +151,7 @@ StereoObservation EpipolarSearch::Observe(int x, int y, float min_idepth, float 
     return out;
   }
   for (int j = 0; j < num_positions; ++j) {
-    if (std::abs(j - best) > 1 &&
-        ssd[static_cast<std::size_t>(j)] < options_.ambiguity_ratio * best_ssd) {
+    if (std::abs(j - best) > 1 && ssd[Idx(j)] < options_.ambiguity_ratio * best_ssd) {
       out.status = StereoStatus::kAmbiguous;
       return out;
     }
@@ -159,8 +159,7 @@ StereoObservation EpipolarSearch::Observe(int x, int y, float min_idepth, float 
   // Sub-pixel: vertex of the parabola through the SSD at best - 1, best, best + 1.
   float offset_px = 0.0f;
   if (best > 0 && best + 1 < num_positions) {
-    const float a = ssd[static_cast<std::size_t>(best - 1)], b = best_ssd,
-                c = ssd[static_cast<std::size_t>(best + 1)];
+    const float a = ssd[Idx(best - 1)], b = best_ssd, c = ssd[Idx(best + 1)];
     const float denom = a - 2.0f * b + c;
     if (denom > 1e-6f) offset_px = std::clamp(0.5f * (a - c) / denom, -0.5f, 0.5f);
   }

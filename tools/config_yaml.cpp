@@ -82,15 +82,18 @@ void ApplyConfigYaml(const std::string& path, SystemOptions* options) {
       throw InputError(path, LineOf(section.second), "section '" + name + "' must be a mapping");
     for (const auto& entry : section.second) {
       const std::string key = entry.first.as<std::string>();
+      std::string qualified = name;
+      qualified += '.';
+      qualified += key;
       const auto setter = found->second.find(key);
       if (setter == found->second.end()) {
-        throw InputError(path, LineOf(entry.first), "unknown key '" + name + "." + key + "'");
+        throw InputError(path, LineOf(entry.first), "unknown key '" + qualified + "'");
       }
       try {
         setter->second(entry.second);
       } catch (const YAML::Exception&) {
         throw InputError(path, LineOf(entry.second),
-                         "'" + name + "." + key + "' has a value of the wrong type");
+                         "'" + qualified + "' has a value of the wrong type");
       }
     }
   }

@@ -9,6 +9,7 @@
 #include "core/check.hpp"
 #include "tracking/levenberg_marquardt.hpp"
 #include "tracking/photometric_residual.hpp"
+#include "tracking/tracking_quality.hpp"
 
 namespace parallax {
 namespace {
@@ -168,17 +169,11 @@ TrackingResult Se3Tracker::Finish(const TrackingReference& reference, const Fram
   result.T_kf_frame = state.T_frame_kf.Inverse();
   result.affine = state.affine;
   TrackingStats& s = result.stats;
-  const auto total = static_cast<double>(reference.Level(level).Size());
-  s.points_in_view = e.in_view;
-  s.usage = total > 0 ? e.in_view / total : 0.0;
-  if (e.in_view > 0) {
-    s.residual_rms = std::sqrt(e.sum_sq_residual / e.in_view);
-    s.good_ratio = static_cast<double>(e.good) / e.in_view;
-    s.mean_gradient_sq = e.sum_gradient_sq / e.in_view;
-  }
+  const std::size_t total = reference.Level(level).Size();
+  FillPointStatistics({e.in_view, e.good, e.sum_sq_residual, e.sum_gradient_sq}, total, &s);
   const bool finite = result.T_kf_frame.Translation().allFinite() &&
                       std::isfinite(state.affine.a) && std::isfinite(state.affine.b);
-  if (!finite || e.in_view < std::max(20.0, options_.min_usage * total)) {
+  if (!finite || e.in_view < std::max(20.0, options_.min_usage * static_cast<double>(total))) {
     s.diverged = true;
     s.reason = "too few points in view or non-finite estimate";
     result.status = TrackingStatus::kLost;
@@ -188,15 +183,13 @@ TrackingResult Se3Tracker::Finish(const TrackingReference& reference, const Fram
   } else if (std::abs(state.affine.a) > options_.max_abs_affine_a) {
     s.reason = "brightness gain out of range";
     result.status = TrackingStatus::kLost;
-  } else if (s.good_ratio < options_.min_good_ratio_poor) {
-    s.reason = "most points inconsistent";
-    result.status = TrackingStatus::kLost;
-  } else if (s.good_ratio < options_.min_good_ratio_ok || s.usage < options_.min_usage_ok) {
-    s.reason =
-        s.good_ratio < options_.min_good_ratio_ok ? "many inconsistent points" : "little overlap";
-    result.status = TrackingStatus::kPoor;
   } else {
-    result.status = TrackingStatus::kOk;
+    result.status =
+        ClassifyConsistency(options_.min_good_ratio_poor, options_.min_good_ratio_ok, &s);
+    if (result.status == TrackingStatus::kOk && s.usage < options_.min_usage_ok) {
+      s.reason = "little overlap";
+      result.status = TrackingStatus::kPoor;
+    }
   }
   return result;
 }

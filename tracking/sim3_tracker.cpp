@@ -8,6 +8,7 @@
 #include "core/normal_equations.hpp"
 #include "tracking/levenberg_marquardt.hpp"
 #include "tracking/photometric_residual.hpp"
+#include "tracking/tracking_quality.hpp"
 
 namespace parallax {
 namespace {
@@ -195,13 +196,10 @@ Sim3TrackingResult Sim3Tracker::Track(const TrackingReference& reference,
   result.affine = state.affine;
   result.depth_residuals = last.depth_residuals;
   TrackingStats& s = result.stats;
-  const auto total = static_cast<double>(reference.Level(finest).Size());
-  s.points_in_view = last.in_view;
-  s.usage = total > 0 ? last.in_view / total : 0.0;
+  const std::size_t total = reference.Level(finest).Size();
+  FillPointStatistics({last.in_view, last.good, last.sum_sq_residual, last.sum_gradient_sq}, total,
+                      &s);
   if (last.in_view > 0) {
-    s.residual_rms = std::sqrt(last.sum_sq_residual / last.in_view);
-    s.good_ratio = static_cast<double>(last.good) / last.in_view;
-    s.mean_gradient_sq = last.sum_gradient_sq / last.in_view;
     // Marginalise the affine parameters: I = H_pp - H_pa H_aa^-1 H_ap (raw sums, not per point).
     const Eigen::Matrix<double, kParams, kParams> H = last.equations.SymmetricH();
     Eigen::Matrix<double, 7, 7> info = H.topLeftCorner<7, 7>();
@@ -214,18 +212,14 @@ Sim3TrackingResult Sim3Tracker::Track(const TrackingReference& reference,
     const Eigen::Matrix<double, 7, 7> adj_inv = result.S_ref_other.Adjoint().inverse();
     result.information = adj_inv.transpose() * info * adj_inv;
   }
-  if (s.diverged || last.in_view < std::max(20.0, options_.min_usage * total)) {
+  if (s.diverged ||
+      last.in_view < std::max(20.0, options_.min_usage * static_cast<double>(total))) {
     s.diverged = true;
     s.reason = "diverged or too few points in view";
     result.status = TrackingStatus::kLost;
-  } else if (s.good_ratio < options_.min_good_ratio_poor) {
-    s.reason = "most points inconsistent";
-    result.status = TrackingStatus::kLost;
-  } else if (s.good_ratio < options_.min_good_ratio_ok) {
-    s.reason = "many inconsistent points";
-    result.status = TrackingStatus::kPoor;
   } else {
-    result.status = TrackingStatus::kOk;
+    result.status =
+        ClassifyConsistency(options_.min_good_ratio_poor, options_.min_good_ratio_ok, &s);
   }
   return result;
 }

@@ -41,6 +41,16 @@ ErrorSummary Summarize(const InverseDepthMap& map, const ImageF& truth) {
   return s;
 }
 
+// Variance image of a prior whose standard deviation is `fraction` of each inverse depth.
+ImageF RelativeVariance(const ImageF& idepth, float fraction) {
+  ImageF variance(idepth.Width(), idepth.Height(), 0.0f);
+  for (std::size_t i = 0; i < variance.NumPixels(); ++i) {
+    const float sigma = fraction * idepth.Data()[i];
+    variance.Data()[i] = sigma * sigma;
+  }
+  return variance;
+}
+
 class DepthFilterTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -87,12 +97,7 @@ TEST_F(DepthFilterTest, ConvergesFromRandomInitialisationWithExactPoses) {
 TEST_F(DepthFilterTest, UpdateOfCorrectPriorReducesVarianceAndStaysWithinSigma) {
   DepthFilter filter;
   InverseDepthMap map(keyframe_->frame, filter.Options());
-  ImageF prior_var(map.Width(), map.Height(), 0.0f);
-  for (std::size_t i = 0; i < prior_var.NumPixels(); ++i) {
-    const float d = keyframe_->idepth.Data()[i];
-    prior_var.Data()[i] = (0.05f * d) * (0.05f * d);
-  }
-  map.InitializeFromPrior(keyframe_->idepth, prior_var);
+  map.InitializeFromPrior(keyframe_->idepth, RelativeVariance(keyframe_->idepth, 0.05f));
   const std::vector<float> before = map.idepth, var_before = map.variance;
   const std::vector<std::uint16_t> obs_before = map.observations;
   const std::vector<std::uint8_t> valid_before = map.valid;
@@ -122,12 +127,7 @@ TEST_F(DepthFilterTest, UpdateOfCorrectPriorReducesVarianceAndStaysWithinSigma) 
 TEST_F(DepthFilterTest, PropagationKeepsVisiblePoints) {
   DepthFilter filter;
   InverseDepthMap map(keyframe_->frame, filter.Options());
-  ImageF prior_var(map.Width(), map.Height(), 0.0f);
-  for (std::size_t i = 0; i < prior_var.NumPixels(); ++i) {
-    const float d = keyframe_->idepth.Data()[i];
-    prior_var.Data()[i] = (0.02f * d) * (0.02f * d);
-  }
-  map.InitializeFromPrior(keyframe_->idepth, prior_var);
+  map.InitializeFromPrior(keyframe_->idepth, RelativeVariance(keyframe_->idepth, 0.02f));
   const RenderedKeyframe next = test::RenderTestKeyframe(*scene_, Pose(12));
   const SE3d T_new_old = Pose(12).Inverse() * T_w_kf_;
   PropagationStats stats;
@@ -168,12 +168,7 @@ TEST_F(DepthFilterTest, PropagationTransportsVarianceWithDepthChange) {
   // by (d_new/d_old)^4 (first-order transport of 1/z).
   DepthFilter filter;
   InverseDepthMap map(keyframe_->frame, filter.Options());
-  ImageF prior_var(map.Width(), map.Height(), 0.0f);
-  for (std::size_t i = 0; i < prior_var.NumPixels(); ++i) {
-    const float d = keyframe_->idepth.Data()[i];
-    prior_var.Data()[i] = (0.02f * d) * (0.02f * d);
-  }
-  map.InitializeFromPrior(keyframe_->idepth, prior_var);
+  map.InitializeFromPrior(keyframe_->idepth, RelativeVariance(keyframe_->idepth, 0.02f));
   const SE3d T_w_new = T_w_kf_ * SE3d(SO3d(), Eigen::Vector3d(0.0, 0.0, 0.4));
   const RenderedKeyframe next = test::RenderTestKeyframe(*scene_, T_w_new);
   const SE3d T_new_old = T_w_new.Inverse() * T_w_kf_;
@@ -210,12 +205,7 @@ TEST_F(DepthFilterTest, OccluderDoesNotCorruptBackground) {
                 centre + Eigen::Vector3d(0.15, 0.15, 0.05), 4, 0.3);
   DepthFilter filter;
   InverseDepthMap map(keyframe_->frame, filter.Options());
-  ImageF prior_var(map.Width(), map.Height(), 0.0f);
-  for (std::size_t i = 0; i < prior_var.NumPixels(); ++i) {
-    const float d = keyframe_->idepth.Data()[i];
-    prior_var.Data()[i] = (0.05f * d) * (0.05f * d);
-  }
-  map.InitializeFromPrior(keyframe_->idepth, prior_var);
+  map.InitializeFromPrior(keyframe_->idepth, RelativeVariance(keyframe_->idepth, 0.05f));
   std::vector<std::uint8_t> hidden(map.valid.size(), 0);
   for (int i = 1; i <= 10; ++i) {
     const auto frame = test::RenderTestFrame(occluded, Pose(i), 100 + i);
