@@ -74,20 +74,75 @@ std::vector<RevisedPose> System::FinishInitialisation() {
   return revised;
 }
 
+void System::StartRandom(const std::shared_ptr<const Frame>& frame) {
+  // LSD-style start: random inverse depth (mean 1) that the first frames refine.
+  InverseDepthMap map(frame, options_.depth);
+  map.InitializeRandom(1.0f);
+  StartKeyframe(frame, Sim3d(), std::move(map));
+}
+
+FrameResult System::ProcessBeforeBootstrap(const std::shared_ptr<const Frame>& frame,
+                                           const ImageU8& image) {
+  FrameResult result;
+  result.stats.reason = "initialising";
+  const auto T_frame_kf = bootstrap_->TryFrame(image);
+  if (!T_frame_kf) {
+    bootstrap_frames_.push_back(frame);
+    if (static_cast<int>(bootstrap_frames_.size()) >= options_.bootstrap_max_frames) {
+      bootstrap_.reset();  // no usable pair: start over from random depth at this frame
+      bootstrap_frames_.clear();
+      StartRandom(frame);
+      result.status = TrackingStatus::kOk;
+      result.T_w_c = S_w_kf_.RigidPart();
+      result.is_keyframe = true;
+    }
+    return result;
+  }
+  // Stereo with the bootstrap pose creates the keyframe's depth (full-range searches); then
+  // the scale is normalised and the frames seen so far are tracked against it in order.
+  depth_filter_.Update(map_.get(), StereoFrame{frame.get(), *T_frame_kf});
+  const float s = depth_filter_.NormalizeScale(map_.get());
+  RebuildReference();
+  bootstrap_.reset();
+  SE3d guess;
+  for (const auto& buffered : bootstrap_frames_) {
+    const TrackingResult r = tracker_.Track(*reference_, *buffered, {guess}, affine_);
+    if (r.status == TrackingStatus::kLost) continue;
+    guess = r.T_kf_frame;
+    initial_frames_.emplace_back(buffered, r.T_kf_frame);
+    const Sim3d S_w_c = S_w_kf_ * Sim3d(r.T_kf_frame);
+    result.revised.push_back({buffered->Id(), buffered->Timestamp(), S_w_c.RigidPart()});
+  }
+  bootstrap_frames_.clear();
+  // Normalisation multiplied inverse depths by s: lengths in keyframe units scale by 1/s.
+  const SE3d T_kf_frame(T_frame_kf->Inverse().Rotation(), T_frame_kf->Inverse().Translation() / s);
+  T_kf_last_ = T_kf_frame;
+  result.status = TrackingStatus::kOk;
+  result.stats.reason.clear();
+  result.T_w_c = (S_w_kf_ * Sim3d(T_kf_frame)).RigidPart();
+  initial_frames_.emplace_back(frame, T_kf_frame);
+  return result;
+}
+
 FrameResult System::ProcessFrame(const ImageU8& image, double timestamp) {
   auto frame =
       std::make_shared<const Frame>(frame_count_++, timestamp, camera_, image, options_.pyramid);
   FrameResult result;
   if (!map_) {
-    // LSD-style start: random inverse depth (mean 1) that the first frames refine.
-    InverseDepthMap map(frame, options_.depth);
-    map.InitializeRandom(1.0f);
-    StartKeyframe(frame, Sim3d(), std::move(map));
+    if (options_.initialization == Initialization::kTwoView) {
+      // Keyframe with an empty map; its depth comes from the first good two-view pair.
+      StartKeyframe(frame, Sim3d(), InverseDepthMap(frame, options_.depth));
+      bootstrap_ = std::make_unique<TwoViewBootstrap>(camera_, options_.bootstrap);
+      bootstrap_->SetReference(image);
+    } else {
+      StartRandom(frame);
+    }
     result.status = TrackingStatus::kOk;
     result.T_w_c = SE3d();
     result.is_keyframe = true;
     return result;
   }
+  if (bootstrap_) return ProcessBeforeBootstrap(frame, image);
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   const TrackingResult tracked =

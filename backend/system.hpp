@@ -6,6 +6,7 @@
 #include <optional>
 #include <vector>
 
+#include "backend/two_view_bootstrap.hpp"
 #include "core/frame.hpp"
 #include "core/image.hpp"
 #include "core/pinhole_camera.hpp"
@@ -16,7 +17,16 @@
 
 namespace parallax {
 
+enum class Initialization {
+  kRandom,   ///< LSD-SLAM style random inverse depth refined by the first frames
+  kTwoView,  ///< ORB + essential matrix between the first frame and a later one, then stereo
+};
+
 struct SystemOptions {
+  Initialization initialization = Initialization::kRandom;
+  TwoViewBootstrapOptions bootstrap;
+  /// Two-view: give up and start from random depth after this many frames without a pair.
+  int bootstrap_max_frames = 60;
   PyramidOptions pyramid;
   TrackingReferenceOptions reference;
   Se3TrackerOptions tracker;
@@ -90,6 +100,9 @@ class System {
                      InverseDepthMap map);
   void RebuildReference();
   std::vector<RevisedPose> FinishInitialisation();
+  FrameResult ProcessBeforeBootstrap(const std::shared_ptr<const Frame>& frame,
+                                     const ImageU8& image);
+  void StartRandom(const std::shared_ptr<const Frame>& frame);
 
   PinholeCamera camera_;
   SystemOptions options_;
@@ -108,7 +121,9 @@ class System {
   int depth_updates_ = 0;
   int initialised_at_frame_ = -1;
   std::vector<std::pair<std::shared_ptr<const Frame>, SE3d>>
-      initial_frames_;  ///< frame, T_kf_frame
+      initial_frames_;                           ///< frame, T_kf_frame
+  std::unique_ptr<TwoViewBootstrap> bootstrap_;  ///< set while a two-view start is pending
+  std::vector<std::shared_ptr<const Frame>> bootstrap_frames_;
 };
 
 }  // namespace parallax

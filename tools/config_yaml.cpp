@@ -46,7 +46,18 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"max_variance", Set(&o->depth.max_variance)},
         {"seed", Set(&o->depth.seed)}}},
       {"system",
-       {{"keyframe_distance", Set(&o->keyframe_distance)},
+       {{"initialization",
+         [o](const YAML::Node& node) {
+           const std::string value = node.as<std::string>();
+           if (value != "random" && value != "two_view")
+             throw YAML::Exception(node.Mark(), "bad value");
+           o->initialization =
+               value == "random" ? Initialization::kRandom : Initialization::kTwoView;
+         }},
+        {"bootstrap_max_frames", Set(&o->bootstrap_max_frames)},
+        {"bootstrap_min_parallax_deg", Set(&o->bootstrap.min_parallax_deg)},
+        {"bootstrap_min_inliers", Set(&o->bootstrap.min_inliers)},
+        {"keyframe_distance", Set(&o->keyframe_distance)},
         {"min_keyframe_usage", Set(&o->min_keyframe_usage)},
         {"min_keyframe_good_ratio", Set(&o->min_keyframe_good_ratio)},
         {"min_update_baseline", Set(&o->min_update_baseline)},

@@ -78,7 +78,7 @@ Pair MakePair(const Sim3d& S_gt_est, double noise, std::uint64_t seed) {
 }
 
 TEST(Association, GreedyOneToOneBySmallestGap) {
-  const auto at = [](std::vector<double> ts) {
+  const auto at = [](const std::vector<double>& ts) {
     Trajectory t;
     for (const double s : ts) t.push_back({s, SE3d()});
     return t;

@@ -26,9 +26,10 @@ void AddRunCommand(CLI::App& app, int* exit_code) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--config", *config, "pipeline options, YAML (docs/configuration.md)");
   cmd->add_flag("--realtime", *realtime, "threaded real-time mode (not implemented yet)");
-  cmd->callback([options, format, realtime, exit_code] {
+  cmd->callback([options, format, realtime, config, exit_code] {
     if (*realtime)
       throw std::invalid_argument("--realtime is not implemented yet; the deterministic mode runs");
+    if (!config->empty()) ApplyConfigYaml(*config, &options->system);
     options->dataset_options.format = DatasetFormatFromString(*format);
     options->progress = isatty(STDERR_FILENO) != 0;
     const RunSummary s = RunDataset(*options);
