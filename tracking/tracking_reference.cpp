@@ -27,7 +27,8 @@ ReferenceLevel Coarsen(const ReferenceLevel& fine, const Frame& frame, int coars
   for (std::size_t i = 0; i < fine.Size(); ++i) {
     const int x = static_cast<int>(fine.u[i]) / 2, y = static_cast<int>(fine.v[i]) / 2;
     if (x >= w || y >= h) continue;  // odd trailing row/column has no parent
-    const auto index = static_cast<std::size_t>(y * w + x);
+    const auto index =
+        static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
     const double weight = 1.0 / fine.variance[i];
     sum_w[index] += weight;
     sum_wd[index] += weight * fine.idepth[i];
@@ -37,7 +38,8 @@ ReferenceLevel Coarsen(const ReferenceLevel& fine, const Frame& frame, int coars
   // The 1-pixel border has no gradient (pyramid convention), so it cannot constrain tracking.
   for (int y = 1; y < h - 1; ++y) {
     for (int x = 1; x < w - 1; ++x) {
-      const auto index = static_cast<std::size_t>(y * w + x);
+      const auto index =
+          static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
       if (sum_w[index] <= 0.0) continue;
       AddPoint(&coarse, camera, image, x, y, static_cast<float>(sum_wd[index] / sum_w[index]),
                static_cast<float>(1.0 / sum_w[index]));

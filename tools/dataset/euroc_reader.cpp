@@ -30,7 +30,7 @@ YAML::Node LoadSensorYaml(const std::string& file) {
   std::string line;
   bool first = true;
   while (std::getline(in, line)) {
-    if (first && line.rfind("%YAML", 0) == 0) line = "#" + line;
+    if (first && line.rfind("%YAML", 0) == 0) line.insert(0, "#");
     first = false;
     text << line << "\n";
   }

@@ -44,6 +44,7 @@ MonoCameraFile ReadMonoCameraFile(const std::string& file) {
     fields.erase(fields.begin());
   }
   std::vector<double> values;
+  values.reserve(fields.size());
   for (const auto& f : fields) values.push_back(ParseDouble(f, file, 1, "camera parameter"));
   const auto size = ParseNumbers(lines[1], file, 2, 2);
   const int w = static_cast<int>(size[0]);

@@ -127,7 +127,8 @@ RenderedView Render(const Scene& scene, const PinholeCamera& K, const SE3d& T_w_
   };
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      const Hit& hit = hits[static_cast<std::size_t>(y * w + x)];
+      const Hit& hit = hits[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) +
+                            static_cast<std::size_t>(x)];
       const double rx = (x - K.Cx()) * inv_fx, ry = (y - K.Cy()) * inv_fy;
       bool edge = false;
       if (options.antialias) {
@@ -135,7 +136,9 @@ RenderedView Render(const Scene& scene, const PinholeCamera& K, const SE3d& T_w_
              {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
           const int nx = x + dx, ny = y + dy;
           edge |= nx >= 0 && ny >= 0 && nx < w && ny < h &&
-                  hits[static_cast<std::size_t>(ny * w + nx)].quad != hit.quad;
+                  hits[static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) +
+                       static_cast<std::size_t>(nx)]
+                          .quad != hit.quad;
         }
       }
       if (!edge) {
