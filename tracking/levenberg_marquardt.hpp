@@ -3,8 +3,10 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace parallax {
 
@@ -28,6 +30,11 @@ struct LmSettings {
   /// Only the first `active` parameters are solved for (others stay fixed); -1: all.
   int active = -1;
 };
+
+/// Iteration budget of `level` from a per-level list (missing entries use the last one).
+inline int MaxIterationsForLevel(const std::vector<int>& per_level, int level) {
+  return per_level[std::min(static_cast<std::size_t>(level), per_level.size() - 1)];
+}
 
 /// Minimises from *state. `linearize(state)` returns LinearizedProblem<N>; `retract(state,
 /// delta)` applies a step. Steps solve (H + lambda diag(H)) delta = -g; lambda is 0 while

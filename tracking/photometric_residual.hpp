@@ -6,6 +6,7 @@
 
 #include "core/image.hpp"
 #include "core/image_pyramid.hpp"
+#include "core/pinhole_camera.hpp"
 
 namespace parallax {
 
@@ -14,6 +15,13 @@ struct LevelCamera {
   float fx, fy, cx, cy;
   float max_u, max_v;  ///< width - 2, height - 2: last positions with a valid 2x2 stencil
 };
+
+/// Float camera of a pyramid level with the last valid interpolation positions.
+inline LevelCamera ToLevelCamera(const PinholeCamera& c) {
+  return {static_cast<float>(c.Fx()),        static_cast<float>(c.Fy()),
+          static_cast<float>(c.Cx()),        static_cast<float>(c.Cy()),
+          static_cast<float>(c.Width() - 2), static_cast<float>(c.Height() - 2)};
+}
 
 /// Residual of one reference point warped into the frame.
 struct PhotometricTerm {

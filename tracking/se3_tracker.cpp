@@ -16,16 +16,6 @@ namespace {
 
 constexpr std::size_t kBlockSize = 2048;  // points per deterministic partial sum
 
-LevelCamera ToLevelCamera(const PinholeCamera& c) {
-  return {static_cast<float>(c.Fx()),        static_cast<float>(c.Fy()),
-          static_cast<float>(c.Cx()),        static_cast<float>(c.Cy()),
-          static_cast<float>(c.Width() - 2), static_cast<float>(c.Height() - 2)};
-}
-
-int MaxIterations(const std::vector<int>& per_level, int level) {
-  return per_level[std::min(static_cast<std::size_t>(level), per_level.size() - 1)];
-}
-
 }  // namespace
 
 std::string ToString(TrackingStatus status) {
@@ -203,8 +193,9 @@ TrackingResult Se3Tracker::TrackFrom(const TrackingReference& reference, const F
   const int finest = std::min(options_.finest_level, reference.NumLevels() - 1);
   std::array<int, kMaxPyramidLevels> iterations{};
   for (int level = reference.NumLevels() - 1; level >= finest; --level) {
-    iterations[static_cast<std::size_t>(level)] = OptimizeLevel(
-        reference, frame, level, MaxIterations(options_.max_iterations, level), prior, &state);
+    iterations[static_cast<std::size_t>(level)] =
+        OptimizeLevel(reference, frame, level,
+                      MaxIterationsForLevel(options_.max_iterations, level), prior, &state);
   }
   TrackingResult result = Finish(reference, frame, state);
   result.stats.iterations = iterations;

@@ -51,9 +51,7 @@ struct Evaluation {
 Evaluation EvaluateLevel(const Sim3TrackerOptions& options, const ReferenceLevel& points,
                          const PyramidLevel& image, const PinholeCamera& K, const DepthLevel& depth,
                          const State& state) {
-  const LevelCamera camera{static_cast<float>(K.Fx()),        static_cast<float>(K.Fy()),
-                           static_cast<float>(K.Cx()),        static_cast<float>(K.Cy()),
-                           static_cast<float>(K.Width() - 2), static_cast<float>(K.Height() - 2)};
+  const LevelCamera camera = ToLevelCamera(K);
   const Eigen::Matrix3f M =
       (state.S_other_ref.Scale() * state.S_other_ref.Rotation().Matrix()).cast<float>();
   const Eigen::Vector3f t = state.S_other_ref.Translation().cast<float>();
@@ -102,10 +100,6 @@ Evaluation EvaluateLevel(const Sim3TrackerOptions& options, const ReferenceLevel
   }
   block.FlushInto(&e.equations);
   return e;
-}
-
-int MaxIterations(const std::vector<int>& per_level, int level) {
-  return per_level[std::min(static_cast<std::size_t>(level), per_level.size() - 1)];
 }
 
 }  // namespace
@@ -177,7 +171,7 @@ Sim3TrackingResult Sim3Tracker::Track(const TrackingReference& reference,
       return next;
     };
     LmSettings settings;
-    settings.max_iterations = MaxIterations(options_.max_iterations, level);
+    settings.max_iterations = MaxIterationsForLevel(options_.max_iterations, level);
     settings.relative_tolerance = options_.relative_cost_tolerance;
     settings.min_residuals =
         std::max(20, static_cast<int>(options_.min_usage * static_cast<float>(points.Size())));
