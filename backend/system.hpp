@@ -17,16 +17,28 @@
 
 namespace parallax {
 
+/// How the first keyframe gets its depth (docs/configuration.md, "Choosing the initialisation").
 enum class Initialization {
+  /// Both at once: random depth tracks from the first frame while a two-view pair is sought;
+  /// the pair either confirms the random start (it is kept) or replaces it.
+  kAuto,
   kRandom,   ///< LSD-SLAM style random inverse depth refined by the first frames
   kTwoView,  ///< ORB + essential matrix between the first frame and a later one, then stereo
 };
 
 struct SystemOptions {
-  Initialization initialization = Initialization::kRandom;
+  Initialization initialization = Initialization::kAuto;
   TwoViewBootstrapOptions bootstrap;
-  /// Two-view: give up and start from random depth after this many frames without a pair.
+  /// Give up the two-view search after this many frames without a pair (two_view: then start
+  /// from random depth at that frame; auto: keep the random start).
   int bootstrap_max_frames = 60;
+  /// Auto: the random start agrees with a two-view pair when the rotations differ by less
+  /// than this and the translation directions by less than `auto_max_direction_deg`.
+  double auto_max_rotation_deg = 2.5;
+  double auto_max_direction_deg = 60.0;
+  /// Auto and random: start again from the current frame after this many frames lost in a row
+  /// before initialisation completed.
+  int restart_after_lost = 10;
   PyramidOptions pyramid;
   TrackingReferenceOptions reference;
   Se3TrackerOptions tracker;
@@ -51,11 +63,12 @@ struct SystemOptions {
   void Check() const;
 };
 
-/// A corrected pose of an earlier frame.
+/// A corrected pose of an earlier frame; empty when the earlier pose is withdrawn (the frame
+/// could not be tracked again, or initialisation restarted without it).
 struct RevisedPose {
   std::int64_t frame_id = 0;
   double timestamp = 0.0;
-  SE3d T_w_c;
+  std::optional<SE3d> T_w_c;
 };
 
 /// Per-frame outcome.
@@ -67,7 +80,7 @@ struct FrameResult {
   TrackingStats stats;
   double tracking_ms = 0.0;  ///< wall time of tracking this frame
   double mapping_ms = 0.0;   ///< depth update and keyframe creation
-  /// Earlier frames re-tracked when initialisation completed (empty otherwise).
+  /// Earlier frames re-tracked (or withdrawn) when initialisation completed or restarted.
   std::vector<RevisedPose> revised;
 };
 
@@ -99,10 +112,24 @@ class System {
   void StartKeyframe(const std::shared_ptr<const Frame>& frame, const Sim3d& S_w_kf,
                      InverseDepthMap map);
   void RebuildReference();
+  TrackingResult TrackFrame(const Frame& frame, FrameResult* result);
+  void MapFrame(const std::shared_ptr<const Frame>& frame, const TrackingResult& tracked,
+                FrameResult* result);
+  // Initialisation (system_initialization.cpp).
+  FrameResult StartFirstKeyframe(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
   std::vector<RevisedPose> FinishInitialisation();
-  FrameResult ProcessBeforeBootstrap(const std::shared_ptr<const Frame>& frame,
-                                     const ImageU8& image);
-  void StartRandom(const std::shared_ptr<const Frame>& frame);
+  FrameResult ProcessTwoViewOnly(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
+  std::optional<FrameResult> ProcessWhileInitialising(const std::shared_ptr<const Frame>& frame,
+                                                      const ImageU8& image,
+                                                      const TrackingResult& tracked);
+  bool RandomStartAgrees(const SE3d& T_kf_frame, const TwoViewPair& pair) const;
+  std::optional<SE3d> TrackAgain(const Frame& frame, const SE3d& guess);
+  /// Replaces the first keyframe's depth by stereo with the pair's frame (in initial_frames_)
+  /// and tracks every buffered frame again; returns their revised poses, the last one being
+  /// the newest frame's.
+  std::vector<RevisedPose> StartFromPair(const std::shared_ptr<const Frame>& pair_frame,
+                                         const TwoViewPair& pair);
+  void StartRandom(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
 
   PinholeCamera camera_;
   SystemOptions options_;
@@ -120,10 +147,15 @@ class System {
   int frame_count_ = 0;
   int depth_updates_ = 0;
   int initialised_at_frame_ = -1;
-  std::vector<std::pair<std::shared_ptr<const Frame>, SE3d>>
-      initial_frames_;                           ///< frame, T_kf_frame
-  std::unique_ptr<TwoViewBootstrap> bootstrap_;  ///< set while a two-view start is pending
-  std::vector<std::shared_ptr<const Frame>> bootstrap_frames_;
+  /// Frames before initialisation completed, with T_kf_frame (the last good pose if lost),
+  /// tracked again against the converged depth; the first keyframe is not among them.
+  std::vector<std::pair<std::shared_ptr<const Frame>, SE3d>> initial_frames_;
+  int lost_in_a_row_ = 0;
+  std::unique_ptr<TwoViewBootstrap> bootstrap_;  ///< set while a two-view pair is sought
+  int bootstrap_tries_ = 0;
+  /// Auto: the first good pair, held until the random start has converged (or failed) and
+  /// either agrees with it or is replaced by it.
+  std::optional<std::pair<std::shared_ptr<const Frame>, TwoViewPair>> pending_pair_;
 };
 
 }  // namespace parallax

@@ -16,6 +16,7 @@ struct TwoViewBootstrap::Impl {
   cv::Ptr<cv::ORB> orb;
   std::vector<cv::KeyPoint> ref_keypoints;
   cv::Mat ref_descriptors;
+  ImageU8 ref_image;
 };
 
 void TwoViewBootstrapOptions::Check() const {
@@ -24,12 +25,13 @@ void TwoViewBootstrapOptions::Check() const {
               "must be in (0, 1)");
   CheckOption(min_inliers >= 8, "TwoViewBootstrapOptions", "min_inliers", "must be >= 8");
   CheckOption(min_parallax_deg > 0.0, "TwoViewBootstrapOptions", "min_parallax_deg", "must be > 0");
+  CheckOption(parallax_points >= 1, "TwoViewBootstrapOptions", "parallax_points", "must be >= 1");
 }
 
 TwoViewBootstrap::TwoViewBootstrap(const PinholeCamera& camera,
                                    const TwoViewBootstrapOptions& options)
     : impl_(std::make_unique<Impl>(
-          Impl{camera, options, cv::ORB::create(options.max_features), {}, {}})) {
+          Impl{camera, options, cv::ORB::create(options.max_features), {}, {}, {}})) {
   options.Check();
 }
 TwoViewBootstrap::~TwoViewBootstrap() = default;
@@ -40,48 +42,82 @@ namespace {
 cv::Mat Wrap(const ImageU8& image) {
   return cv::Mat(image.Height(), image.Width(), CV_8UC1, const_cast<std::uint8_t*>(image.Data()));
 }
+
+/// Mean grey value of the 5x5 patch around `p` (clamped to the image).
+double PatchMean(const ImageU8& image, const cv::Point2d& p) {
+  const int cx = std::clamp(static_cast<int>(std::lround(p.x)), 2, image.Width() - 3);
+  const int cy = std::clamp(static_cast<int>(std::lround(p.y)), 2, image.Height() - 3);
+  double sum = 0.0;
+  for (int y = cy - 2; y <= cy + 2; ++y) {
+    for (int x = cx - 2; x <= cx + 2; ++x) sum += image(x, y);
+  }
+  return sum / 25.0;
+}
+
+/// Fits I_b ~ gain * I_a + offset by matching the means and standard deviations of the patch
+/// means (a moment fit is symmetric in the noise of both views, unlike least squares on one).
+void FitBrightness(const std::vector<double>& a, const std::vector<double>& b, TwoViewPair* pair) {
+  const auto n = static_cast<double>(a.size());
+  double mean_a = 0.0, mean_b = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    mean_a += a[i];
+    mean_b += b[i];
+  }
+  mean_a /= n;
+  mean_b /= n;
+  double var_a = 0.0, var_b = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    var_a += (a[i] - mean_a) * (a[i] - mean_a);
+    var_b += (b[i] - mean_b) * (b[i] - mean_b);
+  }
+  if (var_a < 1e-6 || var_b < 1e-6) return;  // flat patches: keep gain 1, offset 0
+  const double gain = std::clamp(std::sqrt(var_b / var_a), 0.25, 4.0);
+  pair->gain = static_cast<float>(gain);
+  pair->offset = static_cast<float>(mean_b - gain * mean_a);
+}
 }  // namespace
 
 void TwoViewBootstrap::SetReference(const ImageU8& image) {
   impl_->ref_keypoints.clear();
   impl_->orb->detectAndCompute(Wrap(image), cv::noArray(), impl_->ref_keypoints,
                                impl_->ref_descriptors);
+  impl_->ref_image = image;
 }
 
-std::optional<SE3d> TwoViewBootstrap::TryFrame(const ImageU8& image) {
-  if (impl_->ref_keypoints.size() < 50) return std::nullopt;
-  std::vector<cv::KeyPoint> keypoints;
-  cv::Mat descriptors;
-  impl_->orb->detectAndCompute(Wrap(image), cv::noArray(), keypoints, descriptors);
-  if (keypoints.size() < 50) return std::nullopt;
+namespace {
+
+constexpr double kDegPerRad = 57.295779513082320876;
+
+struct Matches {
+  std::vector<cv::Point2d> ref, cur;
+};
+
+/// Lowe-ratio-filtered ORB matches from the reference to the frame.
+Matches MatchFeatures(const std::vector<cv::KeyPoint>& ref_keypoints,
+                      const cv::Mat& ref_descriptors, const std::vector<cv::KeyPoint>& keypoints,
+                      const cv::Mat& descriptors, float ratio_test) {
   cv::BFMatcher matcher(cv::NORM_HAMMING);
   std::vector<std::vector<cv::DMatch>> knn;
-  matcher.knnMatch(impl_->ref_descriptors, descriptors, knn, 2);
-  std::vector<cv::Point2d> ref_points, cur_points;
+  matcher.knnMatch(ref_descriptors, descriptors, knn, 2);
+  Matches matches;
   for (const auto& m : knn) {
-    if (m.size() == 2 && m[0].distance < impl_->options.ratio_test * m[1].distance) {
-      ref_points.push_back(impl_->ref_keypoints[static_cast<std::size_t>(m[0].queryIdx)].pt);
-      cur_points.push_back(keypoints[static_cast<std::size_t>(m[0].trainIdx)].pt);
+    if (m.size() == 2 && m[0].distance < ratio_test * m[1].distance) {
+      matches.ref.push_back(ref_keypoints[static_cast<std::size_t>(m[0].queryIdx)].pt);
+      matches.cur.push_back(keypoints[static_cast<std::size_t>(m[0].trainIdx)].pt);
     }
   }
-  if (static_cast<int>(ref_points.size()) < impl_->options.min_inliers) return std::nullopt;
-  cv::Mat K;
-  cv::eigen2cv(impl_->camera.K(), K);
-  cv::Mat inlier_mask;
-  const cv::Mat E = cv::findEssentialMat(ref_points, cur_points, K, cv::RANSAC, 0.999,
-                                         impl_->options.ransac_threshold_px, inlier_mask);
-  if (E.rows != 3 || E.cols != 3) return std::nullopt;
-  cv::Mat R, t, triangulated;
-  const int good =
-      cv::recoverPose(E, ref_points, cur_points, K, R, t, 50.0, inlier_mask, triangulated);
-  if (good < impl_->options.min_inliers) return std::nullopt;
-  Eigen::Matrix3d R_e;
-  Eigen::Vector3d t_e;
-  cv::cv2eigen(R, R_e);
-  cv::cv2eigen(t, t_e);
-  // Triangulation angles and depths in the reference of the inliers.
-  std::vector<double> angles, depths;
-  const Eigen::Vector3d centre_cur_in_ref = -R_e.transpose() * t_e;
+  return matches;
+}
+
+/// Triangulated inliers: depth in the reference and triangulation angle (degrees).
+struct Triangulation {
+  std::vector<double> depths, angles_deg;
+  std::vector<std::size_t> match_index;
+};
+
+Triangulation CollectInliers(const cv::Mat& triangulated, const cv::Mat& inlier_mask,
+                             const Eigen::Vector3d& centre_cur_in_ref) {
+  Triangulation out;
   for (int i = 0; i < triangulated.cols; ++i) {
     if (!inlier_mask.at<std::uint8_t>(i)) continue;
     const double w = triangulated.at<double>(3, i);
@@ -90,18 +126,61 @@ std::optional<SE3d> TwoViewBootstrap::TryFrame(const ImageU8& image) {
                             triangulated.at<double>(2, i) / w);
     if (X.z() <= 0.0) continue;
     const Eigen::Vector3d a = X.normalized(), b = (X - centre_cur_in_ref).normalized();
-    angles.push_back(std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * 180.0 / 3.14159265358979);
-    depths.push_back(X.z());
+    out.angles_deg.push_back(std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * kDegPerRad);
+    out.depths.push_back(X.z());
+    out.match_index.push_back(static_cast<std::size_t>(i));
   }
-  if (static_cast<int>(depths.size()) < impl_->options.min_inliers) return std::nullopt;
-  std::nth_element(angles.begin(), angles.begin() + static_cast<std::ptrdiff_t>(angles.size() / 2),
-                   angles.end());
-  if (angles[angles.size() / 2] < impl_->options.min_parallax_deg) return std::nullopt;
-  std::nth_element(depths.begin(), depths.begin() + static_cast<std::ptrdiff_t>(depths.size() / 2),
-                   depths.end());
-  const double median_depth = depths[depths.size() / 2];
+  return out;
+}
+
+/// The k-th largest value (k >= 1, clamped to the size). Precondition: values not empty.
+double KthLargest(std::vector<double> values, int k) {
+  const auto n = static_cast<std::ptrdiff_t>(values.size());
+  const std::ptrdiff_t index = std::max<std::ptrdiff_t>(0, n - std::min<std::ptrdiff_t>(k, n));
+  std::nth_element(values.begin(), values.begin() + index, values.end());
+  return values[static_cast<std::size_t>(index)];
+}
+
+}  // namespace
+
+std::optional<TwoViewPair> TwoViewBootstrap::TryFrame(const ImageU8& image) {
+  const TwoViewBootstrapOptions& options = impl_->options;
+  if (impl_->ref_keypoints.size() < 50) return std::nullopt;
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+  impl_->orb->detectAndCompute(Wrap(image), cv::noArray(), keypoints, descriptors);
+  if (keypoints.size() < 50) return std::nullopt;
+  const Matches matches = MatchFeatures(impl_->ref_keypoints, impl_->ref_descriptors, keypoints,
+                                        descriptors, options.ratio_test);
+  if (static_cast<int>(matches.ref.size()) < options.min_inliers) return std::nullopt;
+  cv::Mat K, inlier_mask, R, t, triangulated;
+  cv::eigen2cv(impl_->camera.K(), K);
+  const cv::Mat E = cv::findEssentialMat(matches.ref, matches.cur, K, cv::RANSAC, 0.999,
+                                         options.ransac_threshold_px, inlier_mask);
+  if (E.rows != 3 || E.cols != 3) return std::nullopt;  // degenerate or several solutions
+  const int good =
+      cv::recoverPose(E, matches.ref, matches.cur, K, R, t, 50.0, inlier_mask, triangulated);
+  if (good < options.min_inliers) return std::nullopt;
+  Eigen::Matrix3d R_e;
+  Eigen::Vector3d t_e;
+  cv::cv2eigen(R, R_e);
+  cv::cv2eigen(t, t_e);
+  Triangulation tri = CollectInliers(triangulated, inlier_mask, -R_e.transpose() * t_e);
+  if (static_cast<int>(tri.depths.size()) < options.min_inliers) return std::nullopt;
+  TwoViewPair pair;
+  pair.parallax_deg = KthLargest(tri.angles_deg, options.parallax_points);
+  if (pair.parallax_deg < options.min_parallax_deg) return std::nullopt;
   // |t| = 1 in recoverPose's units; scale so the median reference depth becomes 1.
-  return SE3d(SO3d(R_e), t_e / median_depth);
+  const double median_depth = KthLargest(tri.depths, static_cast<int>(tri.depths.size() / 2) + 1);
+  pair.T_frame_ref = SE3d(SO3d(R_e), t_e / median_depth);
+  pair.inliers = static_cast<int>(tri.depths.size());
+  std::vector<double> ref_means, cur_means;
+  for (const std::size_t i : tri.match_index) {
+    ref_means.push_back(PatchMean(impl_->ref_image, matches.ref[i]));
+    cur_means.push_back(PatchMean(image, matches.cur[i]));
+  }
+  FitBrightness(ref_means, cur_means, &pair);
+  return pair;
 }
 
 }  // namespace parallax

@@ -12,17 +12,33 @@ namespace parallax {
 
 struct TwoViewBootstrapOptions {
   int max_features = 1500;
-  float ratio_test = 0.8f;        ///< Lowe's ratio for accepting a match
-  int min_inliers = 80;           ///< essential-matrix inliers with positive depth
-  double min_parallax_deg = 1.5;  ///< median triangulation angle
+  float ratio_test = 0.8f;  ///< Lowe's ratio for accepting a match
+  int min_inliers = 80;     ///< essential-matrix inliers with positive depth
+  /// The pair is good enough when at least `parallax_points` inliers have a triangulation
+  /// angle of `min_parallax_deg` or more (ORB-SLAM's rule; a median would wait forever on
+  /// forward motion, where the points near the direction of travel never gain parallax).
+  double min_parallax_deg = 2.0;
+  int parallax_points = 50;
   double ransac_threshold_px = 1.0;
 
   void Check() const;
 };
 
+/// A reference/frame pair with enough parallax.
+struct TwoViewPair {
+  /// Reference-to-frame pose; translation scaled so that the median depth of the triangulated
+  /// inliers in the reference is 1 (the map's normalised scale).
+  SE3d T_frame_ref;
+  /// Brightness change from the reference to the frame, I_frame ~ gain * I_ref + offset,
+  /// fitted to 5x5 patch means around the inliers (auto-exposure between the two views).
+  float gain = 1.0f;
+  float offset = 0.0f;        ///< grey levels
+  double parallax_deg = 0.0;  ///< the `parallax_points`-th largest triangulation angle
+  int inliers = 0;
+};
+
 /// Estimates the pose of a frame relative to a reference image once the motion between them
-/// has enough parallax. Translation is scaled so that the median depth of the triangulated
-/// inliers in the reference is 1 (the map's normalised scale).
+/// has enough parallax (ORB matches, essential matrix, cheirality, median triangulation angle).
 class TwoViewBootstrap {
  public:
   explicit TwoViewBootstrap(const PinholeCamera& camera,
@@ -32,8 +48,8 @@ class TwoViewBootstrap {
   TwoViewBootstrap& operator=(TwoViewBootstrap&&) noexcept;
 
   void SetReference(const ImageU8& image);
-  /// T_frame_ref when the pair is good enough, else nullopt.
-  std::optional<SE3d> TryFrame(const ImageU8& image);
+  /// The pair when it is good enough, else nullopt. Precondition: SetReference was called.
+  std::optional<TwoViewPair> TryFrame(const ImageU8& image);
 
  private:
   struct Impl;

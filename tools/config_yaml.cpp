@@ -49,13 +49,22 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
        {{"initialization",
          [o](const YAML::Node& node) {
            const std::string value = node.as<std::string>();
-           if (value != "random" && value != "two_view")
-             throw YAML::Exception(node.Mark(), "bad value");
-           o->initialization =
-               value == "random" ? Initialization::kRandom : Initialization::kTwoView;
+           if (value == "auto") {
+             o->initialization = Initialization::kAuto;
+           } else if (value == "random") {
+             o->initialization = Initialization::kRandom;
+           } else if (value == "two_view") {
+             o->initialization = Initialization::kTwoView;
+           } else {
+             throw YAML::Exception(node.Mark(), "bad value (auto, random or two_view)");
+           }
          }},
+        {"auto_max_rotation_deg", Set(&o->auto_max_rotation_deg)},
+        {"auto_max_direction_deg", Set(&o->auto_max_direction_deg)},
+        {"restart_after_lost", Set(&o->restart_after_lost)},
         {"bootstrap_max_frames", Set(&o->bootstrap_max_frames)},
         {"bootstrap_min_parallax_deg", Set(&o->bootstrap.min_parallax_deg)},
+        {"bootstrap_parallax_points", Set(&o->bootstrap.parallax_points)},
         {"bootstrap_min_inliers", Set(&o->bootstrap.min_inliers)},
         {"keyframe_distance", Set(&o->keyframe_distance)},
         {"min_keyframe_usage", Set(&o->min_keyframe_usage)},

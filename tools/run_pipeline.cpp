@@ -81,7 +81,9 @@ RunSummary RunDataset(const RunOptions& options) {
     poses.emplace_back();
     if (result.T_w_c) poses.back() = StampedPose{frame->timestamp, *result.T_w_c};
     for (const RevisedPose& r : result.revised) {
-      poses[static_cast<std::size_t>(r.frame_id)] = StampedPose{r.timestamp, r.T_w_c};
+      auto& pose = poses[static_cast<std::size_t>(r.frame_id)];
+      pose.reset();
+      if (r.T_w_c) pose = StampedPose{r.timestamp, *r.T_w_c};
     }
     tracking_ms.push_back(result.tracking_ms);
     mapping_ms.push_back(result.mapping_ms);

@@ -69,27 +69,58 @@ TEST_F(PipelineTest, DeterministicOutput) {
   EXPECT_EQ(ReadFile(a.out_dir + "/map.ply"), ReadFile(b.out_dir + "/map.ply"));
 }
 
-TEST(Pipeline, TwoViewStartHandlesForwardWalk) {
-  // Forward motion gives the random-depth start little lateral parallax (3.6% of path on this
-  // sequence); the two-view start gets its first depth from an essential-matrix pose instead.
-  const test::TempDirAt dir("parallax_pipeline_walk");
+struct RenderedCase {
+  const char* scene;
+  const char* motion;
+  Initialization initialization;
+  bool exposure;
+};
+
+/// 90 rendered frames of `c`, run with its initialisation; returns ATE as % of path length.
+double RunRendered(const RenderedCase& c, RunSummary* summary) {
+  const test::TempDirAt dir(std::string("parallax_pipeline_") + c.scene + "_" + c.motion);
   synth::SynthOptions synth_options;
-  synth_options.scene = "corridor";
-  synth_options.motion = "walk";
+  synth_options.scene = c.scene;
+  synth_options.motion = c.motion;
   synth_options.frames = 90;
-  synth::WriteSyntheticSequence(synth_options, dir.File("walk"));
+  synth_options.exposure = c.exposure;
+  synth_options.noise_sigma = c.exposure ? 2.0 : 0.0;
+  synth::WriteSyntheticSequence(synth_options, dir.File("seq"));
   RunOptions run;
-  run.dataset = dir.File("walk");
+  run.dataset = dir.File("seq");
   run.out_dir = dir.File("out");
-  run.system.initialization = Initialization::kTwoView;
-  const RunSummary s = RunDataset(run);
-  const EvaluationReport r = Evaluate(ReadTumTrajectory(run.out_dir + "/trajectory.txt"),
-                                      ReadTumTrajectory(run.dataset + "/groundtruth.txt"), {});
-  RecordProperty("ate_percent_of_path", std::to_string(r.ate_rmse_percent_of_path));
+  run.system.initialization = c.initialization;
+  *summary = RunDataset(run);
+  return Evaluate(ReadTumTrajectory(run.out_dir + "/trajectory.txt"),
+                  ReadTumTrajectory(run.dataset + "/groundtruth.txt"), {})
+      .ate_rmse_percent_of_path;
+}
+
+class RenderedMotion : public ::testing::TestWithParam<RenderedCase> {};
+
+TEST_P(RenderedMotion, TracksEveryFrameWithinOnePercentOfPath) {
+  // Forward walk and orbit are the motions a random-depth start gets wrong (3.6% and 12.7%
+  // of path with random alone); the automatic start replaces it by the two-view pair there.
+  // Measured (2026-12-01): walk 0.58%, orbit 0.91%, two-view start with exposure 0.30%.
+  RunSummary s;
+  const double ate_percent = RunRendered(GetParam(), &s);
+  RecordProperty("ate_percent_of_path", std::to_string(ate_percent));
   EXPECT_EQ(s.frames_tracked, 90);
   EXPECT_GT(s.initialised_at_frame, 0);
-  EXPECT_LT(r.ate_rmse_percent_of_path, 1.0);
+  EXPECT_LT(ate_percent, 1.0);
 }
+
+INSTANTIATE_TEST_SUITE_P(
+    Pipeline, RenderedMotion,
+    ::testing::Values(RenderedCase{"corridor", "walk", Initialization::kAuto, false},
+                      RenderedCase{"room", "orbit", Initialization::kAuto, false},
+                      RenderedCase{"room", "shake", Initialization::kTwoView, true}),
+    [](const ::testing::TestParamInfo<RenderedCase>& param_info) {
+      const RenderedCase& c = param_info.param;
+      return std::string(c.scene) + "_" + c.motion +
+             (c.initialization == Initialization::kTwoView ? "_two_view" : "_auto") +
+             (c.exposure ? "_exposure" : "");
+    });
 
 TEST(Pipeline, SharedTumClip) {
   if (test::SharedDataDir().empty())

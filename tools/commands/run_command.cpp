@@ -1,4 +1,5 @@
-// parallax run <dataset> [--format F] [--calib FILE] [--out DIR] [--max-frames N]
+// parallax run <dataset> [--format F] [--calib FILE] [--config FILE] [--out DIR]
+//              [--max-frames N] [--no-loop-closure]
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -26,6 +27,9 @@ void AddRunCommand(CLI::App& app, int* exit_code) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--config", *config, "pipeline options, YAML (docs/configuration.md)");
   cmd->add_flag("--realtime", *realtime, "threaded real-time mode (not implemented yet)");
+  // Accepted so that scripts written against design.md section 5 run today: there is no loop
+  // closure yet, so every run already is one without it.
+  cmd->add_flag("--no-loop-closure")->description("disable loop closure (no effect yet)");
   cmd->callback([options, format, realtime, config, exit_code] {
     if (*realtime)
       throw std::invalid_argument("--realtime is not implemented yet; the deterministic mode runs");

@@ -1,0 +1,211 @@
+// System: the start of a sequence (design.md section 3a, docs/configuration.md).
+
+#include <cmath>
+
+#include "backend/system.hpp"
+
+namespace parallax {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+
+double AngleBetweenDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const double norms = a.norm() * b.norm();
+  if (norms <= 0.0) return 180.0;
+  return std::acos(std::clamp(a.dot(b) / norms, -1.0, 1.0)) * kRadToDeg;
+}
+
+}  // namespace
+
+FrameResult System::StartFirstKeyframe(const std::shared_ptr<const Frame>& frame,
+                                       const ImageU8& image) {
+  if (options_.initialization == Initialization::kTwoView) {
+    // Keyframe with an empty map; its depth comes from the first good two-view pair.
+    StartKeyframe(frame, Sim3d(), InverseDepthMap(frame, options_.depth));
+    bootstrap_ = std::make_unique<TwoViewBootstrap>(camera_, options_.bootstrap);
+    bootstrap_->SetReference(image);
+    bootstrap_tries_ = 0;
+  } else {
+    StartRandom(frame, image);
+  }
+  FrameResult result;
+  result.status = TrackingStatus::kOk;
+  result.T_w_c = SE3d();
+  result.is_keyframe = true;
+  return result;
+}
+
+void System::StartRandom(const std::shared_ptr<const Frame>& frame, const ImageU8& image) {
+  // LSD-style start: random inverse depth (mean 1) that the first frames refine.
+  InverseDepthMap map(frame, options_.depth);
+  map.InitializeRandom(1.0f);
+  StartKeyframe(frame, Sim3d(), std::move(map));
+  depth_updates_ = 0;
+  lost_in_a_row_ = 0;
+  bootstrap_.reset();
+  if (options_.initialization == Initialization::kAuto) {
+    bootstrap_ = std::make_unique<TwoViewBootstrap>(camera_, options_.bootstrap);
+    bootstrap_->SetReference(image);
+    bootstrap_tries_ = 0;
+  }
+}
+
+std::optional<SE3d> System::TrackAgain(const Frame& frame, const SE3d& guess) {
+  const TrackingResult again = tracker_.Track(*reference_, frame, {guess}, affine_);
+  if (again.status == TrackingStatus::kLost) return std::nullopt;
+  return again.T_kf_frame;
+}
+
+std::vector<RevisedPose> System::FinishInitialisation() {
+  std::vector<RevisedPose> revised;
+  bool replaced = false;
+  if (pending_pair_) {
+    // The converged random start must agree with the independent two-view geometry.
+    const auto& [pair_frame, pair] = *pending_pair_;
+    SE3d guess;
+    for (const auto& [frame, T_kf_frame] : initial_frames_) {
+      if (frame == pair_frame) guess = T_kf_frame;
+    }
+    const auto T_kf_pair_frame = TrackAgain(*pair_frame, guess);
+    if (!T_kf_pair_frame || !RandomStartAgrees(*T_kf_pair_frame, pair)) {
+      revised = StartFromPair(pair_frame, pair);
+      replaced = true;
+    }
+    pending_pair_.reset();
+  }
+  if (!replaced) {
+    for (const auto& [frame, T_kf_frame] : initial_frames_) {
+      const auto T_kf_again = TrackAgain(*frame, T_kf_frame);
+      RevisedPose pose{frame->Id(), frame->Timestamp(), std::nullopt};
+      if (T_kf_again) pose.T_w_c = (S_w_kf_ * Sim3d(*T_kf_again)).RigidPart();
+      revised.push_back(pose);
+    }
+  }
+  initial_frames_.clear();
+  bootstrap_.reset();
+  initialised_at_frame_ = frame_count_ - 1;
+  return revised;
+}
+
+FrameResult System::ProcessTwoViewOnly(const std::shared_ptr<const Frame>& frame,
+                                       const ImageU8& image) {
+  FrameResult result;
+  initial_frames_.emplace_back(frame, SE3d());
+  if (const auto pair = bootstrap_->TryFrame(image)) {
+    result.revised = StartFromPair(frame, *pair);
+    result.T_w_c = result.revised.back().T_w_c;
+    result.revised.pop_back();
+    result.status = result.T_w_c ? TrackingStatus::kOk : TrackingStatus::kLost;
+    return result;
+  }
+  result.stats.reason = "initialising";
+  if (++bootstrap_tries_ >= options_.bootstrap_max_frames) {
+    // No usable pair: start over from random depth at this frame; the frames before it stay
+    // without a pose.
+    initial_frames_.clear();
+    StartRandom(frame, image);
+    result.status = TrackingStatus::kOk;
+    result.T_w_c = SE3d();
+    result.is_keyframe = true;
+  }
+  return result;
+}
+
+std::optional<FrameResult> System::ProcessWhileInitialising(
+    const std::shared_ptr<const Frame>& frame, const ImageU8& image,
+    const TrackingResult& tracked) {
+  if (bootstrap_ && !pending_pair_) {
+    if (const auto pair = bootstrap_->TryFrame(image)) {
+      pending_pair_.emplace(frame, *pair);
+      bootstrap_.reset();
+    } else if (++bootstrap_tries_ >= options_.bootstrap_max_frames) {
+      bootstrap_.reset();
+    }
+  }
+  if (tracked.status == TrackingStatus::kOk) {
+    lost_in_a_row_ = 0;
+    return std::nullopt;
+  }
+  FrameResult result;
+  result.stats = tracked.stats;
+  if (pending_pair_) {
+    // The random start is failing and a pair is at hand: start from the pair now.
+    initial_frames_.emplace_back(frame, T_kf_last_);
+    result.revised = StartFromPair(pending_pair_->first, pending_pair_->second);
+    pending_pair_.reset();
+    result.T_w_c = result.revised.back().T_w_c;
+    result.revised.pop_back();
+    result.status = result.T_w_c ? TrackingStatus::kOk : TrackingStatus::kLost;
+    return result;
+  }
+  if (tracked.status == TrackingStatus::kPoor) return std::nullopt;
+  result.status = TrackingStatus::kLost;
+  // Lost frames wait for a pair while one is sought; then a restart is the way out.
+  if (bootstrap_ || ++lost_in_a_row_ < options_.restart_after_lost) {
+    initial_frames_.emplace_back(frame, T_kf_last_);  // tried again when initialised
+    return result;
+  }
+  // The start has failed: withdraw every pose given so far and start again here.
+  result.revised.push_back({map_->KeyframePtr()->Id(), map_->KeyframePtr()->Timestamp(), {}});
+  for (const auto& buffered : initial_frames_) {
+    result.revised.push_back({buffered.first->Id(), buffered.first->Timestamp(), {}});
+  }
+  initial_frames_.clear();
+  keyframes_.clear();
+  map_.reset();
+  StartRandom(frame, image);
+  result.status = TrackingStatus::kOk;
+  result.T_w_c = SE3d();
+  result.is_keyframe = true;
+  return result;
+}
+
+bool System::RandomStartAgrees(const SE3d& T_kf_frame, const TwoViewPair& pair) const {
+  const SE3d T_kf_pair = pair.T_frame_ref.Inverse();
+  const double rotation_deg =
+      (T_kf_frame.Rotation().Inverse() * T_kf_pair.Rotation()).Log().norm() * kRadToDeg;
+  const double direction_deg = AngleBetweenDeg(T_kf_frame.Translation(), T_kf_pair.Translation());
+  return rotation_deg < options_.auto_max_rotation_deg &&
+         direction_deg < options_.auto_max_direction_deg;
+}
+
+std::vector<RevisedPose> System::StartFromPair(const std::shared_ptr<const Frame>& pair_frame,
+                                               const TwoViewPair& pair) {
+  // Stereo with the pair's pose creates the keyframe's depth from scratch (full-range
+  // searches); the scale is normalised and the frames seen so far are tracked against it.
+  map_ = std::make_unique<InverseDepthMap>(map_->KeyframePtr(), options_.depth);
+  depth_filter_.Update(
+      map_.get(), StereoFrame{pair_frame.get(), pair.T_frame_ref, pair.gain, pair.offset, 0.0f});
+  const float s = depth_filter_.NormalizeScale(map_.get());
+  RebuildReference();
+  bootstrap_.reset();
+  depth_updates_ = 1;
+  lost_in_a_row_ = 0;
+  // Normalisation multiplied inverse depths by s: lengths in keyframe units scale by 1/s.
+  const SE3d T_kf_pair_frame(pair.T_frame_ref.Inverse().Rotation(),
+                             pair.T_frame_ref.Inverse().Translation() / s);
+  std::vector<RevisedPose> revised;
+  auto buffered = std::move(initial_frames_);
+  initial_frames_.clear();
+  SE3d guess, previous;
+  affine_ = AffineBrightness{};
+  for (const auto& [frame, unused] : buffered) {
+    if (frame == pair_frame) guess = T_kf_pair_frame;
+    const TrackingResult r = tracker_.Track(*reference_, *frame, {guess}, affine_);
+    RevisedPose pose{frame->Id(), frame->Timestamp(), std::nullopt};
+    if (r.status != TrackingStatus::kLost) {
+      previous = guess;
+      guess = r.T_kf_frame;
+      affine_ = r.affine;
+      pose.T_w_c = (S_w_kf_ * Sim3d(r.T_kf_frame)).RigidPart();
+    }
+    initial_frames_.emplace_back(frame, guess);
+    revised.push_back(pose);
+  }
+  T_prev_last_ = previous.Inverse() * guess;
+  T_kf_last_ = guess;
+  frames_in_keyframe_ = static_cast<int>(buffered.size());
+  return revised;
+}
+
+}  // namespace parallax

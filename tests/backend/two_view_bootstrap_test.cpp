@@ -1,0 +1,105 @@
+// TwoViewBootstrap on rendered pairs with known relative pose and brightness change.
+
+#include "backend/two_view_bootstrap.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "tools/synth/random.hpp"
+#include "tools/synth/renderer.hpp"
+#include "tools/synth/scene.hpp"
+#include "tools/synth/synthetic_sequence.hpp"
+
+namespace parallax {
+namespace {
+
+constexpr double kDegPerRad = 57.295779513082320876;
+
+class TwoViewBootstrapTest : public ::testing::Test {
+ protected:
+  TwoViewBootstrapTest()
+      : scene_(synth::MakeScene("room", 1)),
+        camera_(synth::SynthCamera({})),
+        T_w_ref_(synth::FramePose({}, scene_, 0)) {}
+
+  /// The scene seen from T_w_c, times `gain`, plus Gaussian noise, as 8 bits.
+  ImageU8 RenderImage(const SE3d& T_w_c, double gain, double noise_sigma) const {
+    const synth::RenderedView view = synth::Render(scene_, camera_, T_w_c);
+    synth::Random rng(7);
+    ImageU8 image(camera_.Width(), camera_.Height());
+    for (std::size_t i = 0; i < image.NumPixels(); ++i) {
+      const double v = gain * view.intensity.Data()[i] + noise_sigma * rng.Normal();
+      image.Data()[i] = static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 255.0)));
+    }
+    return image;
+  }
+
+  /// Frame pose after moving by `T_ref_frame` (camera motion in the reference frame).
+  SE3d Moved(const SE3d& T_ref_frame) const { return T_w_ref_ * T_ref_frame; }
+
+  synth::Scene scene_;
+  PinholeCamera camera_;
+  SE3d T_w_ref_;
+};
+
+TEST_F(TwoViewBootstrapTest, RecoversRotationTranslationDirectionAndGain) {
+  // 20 cm sideways and 5 cm forward with a 3 degree turn (a hand-held start after about a
+  // second); 1 grey level of noise and a brightness change.
+  const SE3d T_ref_frame(SO3d::Exp(Eigen::Vector3d(0.0, 3.0 / kDegPerRad, 0.0)),
+                         Eigen::Vector3d(0.20, 0.0, 0.05));
+  TwoViewBootstrap bootstrap(camera_);
+  bootstrap.SetReference(RenderImage(T_w_ref_, 1.0, 1.0));
+  const auto pair = bootstrap.TryFrame(RenderImage(Moved(T_ref_frame), 1.2, 1.0));
+  ASSERT_TRUE(pair.has_value());
+  const SE3d T_frame_ref_true = T_ref_frame.Inverse();
+  const double rotation_error_deg =
+      (pair->T_frame_ref.Rotation().Inverse() * T_frame_ref_true.Rotation()).Log().norm() *
+      kDegPerRad;
+  const double direction_error_deg =
+      std::acos(std::clamp(pair->T_frame_ref.Translation().normalized().dot(
+                               T_frame_ref_true.Translation().normalized()),
+                           -1.0, 1.0)) *
+      kDegPerRad;
+  // Measured rotation errors of 1.4, 2.9, 1.6 and 0.9 degrees for turns of 0, 3, -3 and 6
+  // degrees with this step, direction errors of 1-6 degrees: a small turn and a sideways step
+  // look alike through a 63 degree lens, and ORB corners on coarse levels are pixel-accurate
+  // only. Bounds catch a wrong decomposition or sign, not this ambiguity; the System refines
+  // the pair's pose by direct tracking (docs/configuration.md, "Choosing the initialisation").
+  EXPECT_LT(rotation_error_deg, 3.5);
+  EXPECT_LT(direction_error_deg, 8.0);
+  EXPECT_GE(pair->parallax_deg, TwoViewBootstrapOptions{}.min_parallax_deg);
+  EXPECT_GE(pair->inliers, TwoViewBootstrapOptions{}.min_inliers);
+  // Intensities were multiplied by 1.2 (a few clip at 255): gain near 1.2, offset near 0.
+  EXPECT_NEAR(pair->gain, 1.2, 0.05);
+  EXPECT_NEAR(pair->offset, 0.0, 8.0);
+}
+
+TEST_F(TwoViewBootstrapTest, RejectsPairsWithoutParallax) {
+  TwoViewBootstrap bootstrap(camera_);
+  bootstrap.SetReference(RenderImage(T_w_ref_, 1.0, 1.0));
+  // Pure rotation: many matches, no triangulation angle.
+  const SE3d rotated(SO3d::Exp(Eigen::Vector3d(0.02, 0.05, 0.0)), Eigen::Vector3d::Zero());
+  EXPECT_FALSE(bootstrap.TryFrame(RenderImage(Moved(rotated), 1.0, 1.0)).has_value());
+  // A 5 mm step: parallax far below the threshold.
+  const SE3d step(SO3d(), Eigen::Vector3d(0.005, 0.0, 0.0));
+  EXPECT_FALSE(bootstrap.TryFrame(RenderImage(Moved(step), 1.0, 1.0)).has_value());
+}
+
+TEST_F(TwoViewBootstrapTest, RejectsATexturelessFrame) {
+  TwoViewBootstrap bootstrap(camera_);
+  bootstrap.SetReference(RenderImage(T_w_ref_, 1.0, 1.0));
+  EXPECT_FALSE(bootstrap.TryFrame(ImageU8(camera_.Width(), camera_.Height(), 90)).has_value());
+}
+
+TEST(TwoViewBootstrapOptions, CheckRejectsBadValues) {
+  TwoViewBootstrapOptions options;
+  options.parallax_points = 0;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+  options = {};
+  options.min_parallax_deg = 0.0;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace parallax
