@@ -45,6 +45,7 @@ void SystemOptions::Check() const {
   CheckOption(min_keyframe_usage >= 0.0 && min_keyframe_usage <= 1.0, "SystemOptions",
               "min_keyframe_usage", "must be in [0, 1]");
   CheckOption(min_update_baseline >= 0.0, "SystemOptions", "min_update_baseline", "must be >= 0");
+  CheckOption(recent_keyframes >= 0, "SystemOptions", "recent_keyframes", "must be >= 0");
   CheckOption(min_frames_per_keyframe >= 1, "SystemOptions", "min_frames_per_keyframe",
               "must be >= 1");
   CheckOption(initialization_updates >= 1, "SystemOptions", "initialization_updates",
@@ -65,7 +66,13 @@ void System::RebuildReference() {
 
 void System::StartKeyframe(const std::shared_ptr<const Frame>& frame, const Sim3d& S_w_kf,
                            InverseDepthMap map) {
-  if (map_) finished_points_.push_back(WorldPoints(*map_, S_w_kf_));
+  if (map_) {
+    finished_points_[map_->KeyframePtr()->Id()] = WorldPoints(*map_, S_w_kf_);
+    if (options_.recent_keyframes > 0) {
+      recent_.push_front({std::move(map_), std::move(reference_), S_w_kf_});
+      if (static_cast<int>(recent_.size()) > options_.recent_keyframes) recent_.pop_back();
+    }
+  }
   map_ = std::make_unique<InverseDepthMap>(std::move(map));
   S_w_kf_ = S_w_kf;
   keyframes_.push_back({frame->Id(), frame->Timestamp(), S_w_kf});
@@ -83,7 +90,16 @@ FrameResult System::ProcessFrame(const ImageU8& image, double timestamp) {
     return ProcessTwoViewOnly(frame, image);
   }
   FrameResult result;
-  const TrackingResult tracked = TrackFrame(*frame, &result);
+  TrackingResult tracked = TrackFrame(*frame, &result);
+  if (tracked.status == TrackingStatus::kLost && initialised_at_frame_ >= 0) {
+    if (auto recovered = TrackRecentKeyframes(*frame)) {
+      tracked = std::move(*recovered);
+      result.status = tracked.status;
+      result.stats = tracked.stats;
+      result.stats.reason = "recovered on a recent keyframe";
+      result.T_w_c = (S_w_kf_ * Sim3d(tracked.T_kf_frame)).RigidPart();
+    }
+  }
   if (initialised_at_frame_ < 0) {
     if (auto handled = ProcessWhileInitialising(frame, image, tracked)) return *handled;
   }
@@ -151,9 +167,39 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const TrackingR
   result->mapping_ms = MillisecondsSince(start);
 }
 
+std::optional<TrackingResult> System::TrackRecentKeyframes(const Frame& frame) {
+  const Sim3d S_w_last = S_w_kf_ * Sim3d(T_kf_last_);
+  for (auto it = recent_.begin(); it != recent_.end(); ++it) {
+    // Two starts, each tracked on its own (the tracker would prefer a start that sees few
+    // points with small residuals): the last pose carried over through the similarities,
+    // and the keyframe's own pose (the camera came back to where it was taken).
+    TrackingResult r = tracker_.Track(
+        *it->reference, frame, {(it->S_w_kf.Inverse() * S_w_last).RigidPart()}, AffineBrightness{});
+    if (r.status != TrackingStatus::kOk) {
+      r = tracker_.Track(*it->reference, frame, {SE3d()}, AffineBrightness{});
+    }
+    if (r.status != TrackingStatus::kOk) continue;
+    // The found keyframe becomes current again; the current one takes its place among the
+    // recent ones (its points are finished; the found one's are live again).
+    finished_points_[map_->KeyframePtr()->Id()] = WorldPoints(*map_, S_w_kf_);
+    finished_points_.erase(it->map->KeyframePtr()->Id());
+    std::swap(map_, it->map);
+    std::swap(reference_, it->reference);
+    std::swap(S_w_kf_, it->S_w_kf);
+    std::rotate(recent_.begin(), it, std::next(it));
+    T_kf_last_ = r.T_kf_frame;
+    T_prev_last_ = SE3d();
+    affine_ = r.affine;
+    frames_in_keyframe_ = 1;
+    return r;
+  }
+  return std::nullopt;
+}
+
 std::vector<Eigen::Vector3f> System::MapPoints() const {
   std::vector<Eigen::Vector3f> all;
-  for (const auto& points : finished_points_) all.insert(all.end(), points.begin(), points.end());
+  for (const auto& [id, points] : finished_points_)
+    all.insert(all.end(), points.begin(), points.end());
   if (map_) {
     const auto current = WorldPoints(*map_, S_w_kf_);
     all.insert(all.end(), current.begin(), current.end());

@@ -2,6 +2,8 @@
 // The visual-odometry pipeline (deterministic mode): tracking against the current keyframe,
 // depth updates, keyframe creation with propagation and scale normalisation.
 
+#include <deque>
+#include <map>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -53,6 +55,10 @@ struct SystemOptions {
   /// No depth update when the baseline relative to the mean depth is below this (static
   /// camera or pure rotation: no parallax, nothing to learn).
   double min_update_baseline = 0.004;
+  /// When tracking against the current keyframe is lost, the last `recent_keyframes` finished
+  /// keyframes are tried (from the pose propagated through the similarities, and from the
+  /// keyframe's own pose); the first that tracks "ok" becomes the current keyframe again.
+  int recent_keyframes = 4;
   /// Frames tracked into a keyframe before it may be replaced.
   int min_frames_per_keyframe = 3;
   /// The random start counts as initialised after this many depth updates of the first
@@ -112,6 +118,9 @@ class System {
   void StartKeyframe(const std::shared_ptr<const Frame>& frame, const Sim3d& S_w_kf,
                      InverseDepthMap map);
   void RebuildReference();
+  /// Tries the recent keyframes for a frame lost against the current one (see
+  /// SystemOptions::recent_keyframes); on success the found keyframe is current again.
+  std::optional<TrackingResult> TrackRecentKeyframes(const Frame& frame);
   TrackingResult TrackFrame(const Frame& frame, FrameResult* result);
   void MapFrame(const std::shared_ptr<const Frame>& frame, const TrackingResult& tracked,
                 FrameResult* result);
@@ -138,7 +147,15 @@ class System {
   std::unique_ptr<InverseDepthMap> map_;
   std::unique_ptr<TrackingReference> reference_;
   std::vector<KeyframeRecord> keyframes_;
-  std::vector<std::vector<Eigen::Vector3f>> finished_points_;
+  /// World points of finished keyframes by keyframe frame id (replaced when a keyframe that
+  /// was returned to finishes again).
+  std::map<std::int64_t, std::vector<Eigen::Vector3f>> finished_points_;
+  struct RecentKeyframe {
+    std::unique_ptr<InverseDepthMap> map;
+    std::unique_ptr<TrackingReference> reference;
+    Sim3d S_w_kf;
+  };
+  std::deque<RecentKeyframe> recent_;  ///< newest first
   Sim3d S_w_kf_;
   SE3d T_kf_last_;
   SE3d T_prev_last_;  ///< last inter-frame motion (for the constant-velocity guess)

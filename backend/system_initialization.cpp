@@ -152,6 +152,8 @@ std::optional<FrameResult> System::ProcessWhileInitialising(
   }
   initial_frames_.clear();
   keyframes_.clear();
+  finished_points_.clear();
+  recent_.clear();
   map_.reset();
   StartRandom(frame, image);
   result.status = TrackingStatus::kOk;

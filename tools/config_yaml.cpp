@@ -71,6 +71,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"min_keyframe_good_ratio", Set(&o->min_keyframe_good_ratio)},
         {"min_update_baseline", Set(&o->min_update_baseline)},
         {"min_frames_per_keyframe", Set(&o->min_frames_per_keyframe)},
+        {"recent_keyframes", Set(&o->recent_keyframes)},
         {"initialization_updates", Set(&o->initialization_updates)}}},
   };
 }
