@@ -1,5 +1,6 @@
-// Google Benchmark of one stereo update of the inverse-depth filter: a 640x480 keyframe of the
-// rendered room with a prior on its pixels (~50k active) and one frame 5 cm to the side.
+// Google Benchmark of one stereo update (and of the regularisation) of the inverse-depth filter: a
+// 640x480 keyframe of the rendered room with a prior on its pixels (~50k active) and one frame 5 cm
+// to the side.
 
 #include <benchmark/benchmark.h>
 
@@ -56,6 +57,21 @@ void BM_StereoUpdate(benchmark::State& state) {
   state.counters["fused"] = stats.fused;
 }
 BENCHMARK(BM_StereoUpdate)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// Regularisation alone (part of every update): the 5x5 smoothing and outlier vote over the
+// ~58k valid pixels of the map.
+void BM_Regularize(benchmark::State& state) {
+  static const Fixture f;
+  const DepthFilter filter;
+  for (auto _ : state) {
+    state.PauseTiming();
+    InverseDepthMap map = *f.map;
+    state.ResumeTiming();
+    filter.Regularize(&map);
+    benchmark::DoNotOptimize(map.idepth_smoothed.data());
+  }
+}
+BENCHMARK(BM_Regularize)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace parallax
