@@ -46,6 +46,9 @@ void SystemOptions::Check() const {
               "min_keyframe_usage", "must be in [0, 1]");
   CheckOption(min_update_baseline >= 0.0, "SystemOptions", "min_update_baseline", "must be >= 0");
   CheckOption(recent_keyframes >= 0, "SystemOptions", "recent_keyframes", "must be >= 0");
+  CheckOption(min_start_texture >= 0.0 && min_start_texture < 1.0, "SystemOptions",
+              "min_start_texture", "must be in [0, 1)");
+  CheckOption(max_buffered_frames >= 1, "SystemOptions", "max_buffered_frames", "must be >= 1");
   CheckOption(min_frames_per_keyframe >= 1, "SystemOptions", "min_frames_per_keyframe",
               "must be >= 1");
   CheckOption(initialization_updates >= 1, "SystemOptions", "initialization_updates",
@@ -145,7 +148,7 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const TrackingR
     if (!want_keyframe) RebuildReference();
   }
   if (initialised_at_frame_ < 0) {
-    initial_frames_.emplace_back(frame, tracked.T_kf_frame);
+    BufferInitialFrame(frame, tracked.T_kf_frame);
     if (depth_updates_ >= options_.initialization_updates || want_keyframe) {
       if (want_keyframe) RebuildReference();
       result->revised = FinishInitialisation();

@@ -38,6 +38,9 @@ struct SystemOptions {
   /// than this and the translation directions by less than `auto_max_direction_deg`.
   double auto_max_rotation_deg = 2.5;
   double auto_max_direction_deg = 60.0;
+  /// The first keyframe needs at least this share of its pixels with enough gradient for
+  /// depth (a dark or blank first frame is skipped and reported lost).
+  double min_start_texture = 0.01;
   /// Auto and random: start again from the current frame after this many frames lost in a row
   /// before initialisation completed.
   int restart_after_lost = 10;
@@ -65,6 +68,9 @@ struct SystemOptions {
   /// keyframe; the frames tracked before that are then tracked again against the converged
   /// depth and their poses revised (design.md section 3a).
   int initialization_updates = 30;
+  /// At most this many frames are kept for re-tracking before initialisation completes (a
+  /// static start would otherwise keep them all); older ones keep their first pose.
+  int max_buffered_frames = 60;
 
   void Check() const;
 };
@@ -133,6 +139,7 @@ class System {
                                                       const TrackingResult& tracked);
   bool RandomStartAgrees(const SE3d& T_kf_frame, const TwoViewPair& pair) const;
   std::optional<SE3d> TrackAgain(const Frame& frame, const SE3d& guess);
+  void BufferInitialFrame(const std::shared_ptr<const Frame>& frame, const SE3d& T_kf_frame);
   /// Replaces the first keyframe's depth by stereo with the pair's frame (in initial_frames_)
   /// and tracks every buffered frame again; returns their revised poses, the last one being
   /// the newest frame's.

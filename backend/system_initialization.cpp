@@ -19,6 +19,13 @@ double AngleBetweenDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 
 FrameResult System::StartFirstKeyframe(const std::shared_ptr<const Frame>& frame,
                                        const ImageU8& image) {
+  FrameResult result;
+  const double textured = static_cast<double>(InverseDepthMap(frame, options_.depth).NumEligible());
+  if (textured < options_.min_start_texture * static_cast<double>(image.NumPixels())) {
+    // A covered lens, a dark room or a blank wall: no keyframe, no pose; try the next frame.
+    result.stats.reason = "too little texture to start";
+    return result;
+  }
   if (options_.initialization == Initialization::kTwoView) {
     // Keyframe with an empty map; its depth comes from the first good two-view pair.
     StartKeyframe(frame, Sim3d(), InverseDepthMap(frame, options_.depth));
@@ -28,7 +35,6 @@ FrameResult System::StartFirstKeyframe(const std::shared_ptr<const Frame>& frame
   } else {
     StartRandom(frame, image);
   }
-  FrameResult result;
   result.status = TrackingStatus::kOk;
   result.T_w_c = SE3d();
   result.is_keyframe = true;
@@ -47,6 +53,15 @@ void System::StartRandom(const std::shared_ptr<const Frame>& frame, const ImageU
     bootstrap_ = std::make_unique<TwoViewBootstrap>(camera_, options_.bootstrap);
     bootstrap_->SetReference(image);
     bootstrap_tries_ = 0;
+  }
+}
+
+void System::BufferInitialFrame(const std::shared_ptr<const Frame>& frame, const SE3d& T_kf_frame) {
+  initial_frames_.emplace_back(frame, T_kf_frame);
+  // A camera that does not move before initialisation would otherwise buffer every frame
+  // (a few MB each); the oldest keep the pose they were given, or stay without one.
+  if (static_cast<int>(initial_frames_.size()) > options_.max_buffered_frames) {
+    initial_frames_.erase(initial_frames_.begin());
   }
 }
 
@@ -90,7 +105,7 @@ std::vector<RevisedPose> System::FinishInitialisation() {
 FrameResult System::ProcessTwoViewOnly(const std::shared_ptr<const Frame>& frame,
                                        const ImageU8& image) {
   FrameResult result;
-  initial_frames_.emplace_back(frame, SE3d());
+  BufferInitialFrame(frame, SE3d());
   if (const auto pair = bootstrap_->TryFrame(image)) {
     result.revised = StartFromPair(frame, *pair);
     result.T_w_c = result.revised.back().T_w_c;
@@ -130,7 +145,7 @@ std::optional<FrameResult> System::ProcessWhileInitialising(
   result.stats = tracked.stats;
   if (pending_pair_) {
     // The random start is failing and a pair is at hand: start from the pair now.
-    initial_frames_.emplace_back(frame, T_kf_last_);
+    BufferInitialFrame(frame, T_kf_last_);
     result.revised = StartFromPair(pending_pair_->first, pending_pair_->second);
     pending_pair_.reset();
     result.T_w_c = result.revised.back().T_w_c;
@@ -142,7 +157,7 @@ std::optional<FrameResult> System::ProcessWhileInitialising(
   result.status = TrackingStatus::kLost;
   // Lost frames wait for a pair while one is sought; then a restart is the way out.
   if (bootstrap_ || ++lost_in_a_row_ < options_.restart_after_lost) {
-    initial_frames_.emplace_back(frame, T_kf_last_);  // tried again when initialised
+    BufferInitialFrame(frame, T_kf_last_);  // tried again when initialised
     return result;
   }
   // The start has failed: withdraw every pose given so far and start again here.
@@ -155,11 +170,9 @@ std::optional<FrameResult> System::ProcessWhileInitialising(
   finished_points_.clear();
   recent_.clear();
   map_.reset();
-  StartRandom(frame, image);
-  result.status = TrackingStatus::kOk;
-  result.T_w_c = SE3d();
-  result.is_keyframe = true;
-  return result;
+  FrameResult restarted = StartFirstKeyframe(frame, image);
+  restarted.revised = std::move(result.revised);
+  return restarted;
 }
 
 bool System::RandomStartAgrees(const SE3d& T_kf_frame, const TwoViewPair& pair) const {

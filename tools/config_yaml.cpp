@@ -62,6 +62,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"auto_max_rotation_deg", Set(&o->auto_max_rotation_deg)},
         {"auto_max_direction_deg", Set(&o->auto_max_direction_deg)},
         {"restart_after_lost", Set(&o->restart_after_lost)},
+        {"min_start_texture", Set(&o->min_start_texture)},
         {"bootstrap_max_frames", Set(&o->bootstrap_max_frames)},
         {"bootstrap_min_parallax_deg", Set(&o->bootstrap.min_parallax_deg)},
         {"bootstrap_parallax_points", Set(&o->bootstrap.parallax_points)},
@@ -72,6 +73,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"min_update_baseline", Set(&o->min_update_baseline)},
         {"min_frames_per_keyframe", Set(&o->min_frames_per_keyframe)},
         {"recent_keyframes", Set(&o->recent_keyframes)},
+        {"max_buffered_frames", Set(&o->max_buffered_frames)},
         {"initialization_updates", Set(&o->initialization_updates)}}},
   };
 }

@@ -13,6 +13,7 @@
 #include "tools/dataset/trajectory.hpp"
 #include "tools/eval/evaluation.hpp"
 #include "tools/run_pipeline.hpp"
+#include "tools/synth/random.hpp"
 #include "tools/synth/renderer.hpp"
 #include "tools/synth/scene.hpp"
 #include "tools/synth/synthetic_sequence.hpp"
@@ -173,6 +174,105 @@ TEST(Pipeline, LostFramesAreRecoveredOnRecentKeyframes) {
   // only an earlier keyframe recovers it; without recent keyframes every later frame is lost.
   EXPECT_GE(TrackedAfterJumpBack(4), 9);
   EXPECT_EQ(TrackedAfterJumpBack(0), 0);
+}
+
+/// The rendered room at the start pose moved by T_start_c, with Gaussian noise, times `gain`.
+ImageU8 RenderRoom(const SE3d& T_start_c, double gain, double noise_sigma, std::uint64_t seed) {
+  static const synth::Scene scene = synth::MakeScene("room", 1);
+  const PinholeCamera camera = synth::SynthCamera({});
+  const synth::RenderedView view =
+      synth::Render(scene, camera, synth::FramePose({}, scene, 0) * T_start_c);
+  synth::Random rng(seed);
+  ImageU8 image(camera.Width(), camera.Height());
+  for (std::size_t i = 0; i < image.NumPixels(); ++i) {
+    const double v = gain * view.intensity.Data()[i] + noise_sigma * rng.Normal();
+    image.Data()[i] = static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 255.0)));
+  }
+  return image;
+}
+
+TEST(Pipeline, StaticCameraInventsNoMotionAndNoKeyframes) {
+  System system(synth::SynthCamera({}));
+  for (int i = 0; i < 200; ++i) {
+    const FrameResult r = system.ProcessFrame(
+        RenderRoom(SE3d(), 1.0, 2.0, 100u + static_cast<std::uint64_t>(i)), i / 30.0);
+    ASSERT_TRUE(r.T_w_c.has_value()) << "frame " << i;
+    EXPECT_LT(r.T_w_c->Translation().norm(), 0.003) << "frame " << i;
+  }
+  EXPECT_EQ(system.Keyframes().size(), 1u);
+  EXPECT_EQ(system.InitialisedAtFrame(), -1);  // no parallax yet: nothing to initialise from
+}
+
+TEST(Pipeline, DarkStartGivesNoPosesThenInitialises) {
+  // 20 frames with the lens covered (grey level ~3 and noise), then hand-held shake.
+  synth::SynthOptions shake;
+  shake.frames = 60;
+  const synth::Scene scene = synth::MakeScene("room", 1);
+  const SE3d T_w_start = synth::FramePose(shake, scene, 0);
+  System system(synth::SynthCamera(shake));
+  std::vector<std::optional<SE3d>> poses;
+  for (int i = 0; i < 80; ++i) {
+    const bool dark = i < 20;
+    const SE3d T_start_c =
+        dark ? SE3d() : T_w_start.Inverse() * synth::FramePose(shake, scene, i - 20);
+    const FrameResult r = system.ProcessFrame(
+        RenderRoom(T_start_c, dark ? 0.02 : 1.0, 1.0, static_cast<std::uint64_t>(i)), i / 30.0);
+    poses.push_back(r.T_w_c);
+    for (const RevisedPose& revised : r.revised) {
+      poses[static_cast<std::size_t>(revised.frame_id)] = revised.T_w_c;
+    }
+  }
+  for (int i = 0; i < 20; ++i) EXPECT_FALSE(poses[static_cast<std::size_t>(i)]) << "frame " << i;
+  int tracked = 0;
+  for (int i = 20; i < 80; ++i) tracked += poses[static_cast<std::size_t>(i)] ? 1 : 0;
+  EXPECT_GE(tracked, 50);
+  EXPECT_GE(system.InitialisedAtFrame(), 20);
+}
+
+TEST(Pipeline, PureRotationKeepsThePositionAndTheMap) {
+  // 30 frames 30 cm sideways, 30 frames turning in place (up to 34 degrees), 30 sideways.
+  synth::SynthOptions rotate;
+  rotate.motion = "rotate";
+  rotate.frames = 90;
+  const synth::Scene scene = synth::MakeScene("room", 1);
+  const SE3d T_w_start = synth::FramePose(rotate, scene, 0);
+  System system(synth::SynthCamera(rotate));
+  std::vector<SE3d> truth;
+  std::vector<std::optional<SE3d>> poses;
+  for (int i = 0; i < rotate.frames; ++i) {
+    truth.push_back(T_w_start.Inverse() * synth::FramePose(rotate, scene, i));
+    const FrameResult r =
+        system.ProcessFrame(RenderRoom(truth.back(), 1.0, 1.0, static_cast<std::uint64_t>(i)),
+                            synth::FrameTimestamp(rotate, i));
+    poses.push_back(r.T_w_c);
+    for (const RevisedPose& revised : r.revised) {
+      poses[static_cast<std::size_t>(revised.frame_id)] = revised.T_w_c;
+    }
+  }
+  for (int i = 0; i < rotate.frames; ++i) ASSERT_TRUE(poses[static_cast<std::size_t>(i)]) << i;
+  // Position: still while turning, relative to the first leg's length (scale is free).
+  const double leg = (poses[30]->Translation() - poses[0]->Translation()).norm();
+  for (int i = 31; i < 60; ++i) {
+    EXPECT_LT((poses[static_cast<std::size_t>(i)]->Translation() - poses[30]->Translation()).norm(),
+              0.1 * leg)
+        << "frame " << i;
+  }
+  // The turn itself, relative to where it began: the start's own error (below) cancels.
+  const SE3d T_30_true = truth[30];
+  for (int i : {40, 45, 50, 60}) {
+    const auto k = static_cast<std::size_t>(i);
+    const SO3d turn = poses[30]->Rotation().Inverse() * poses[k]->Rotation();
+    const SO3d turn_true = T_30_true.Rotation().Inverse() * truth[k].Rotation();
+    EXPECT_LT((turn.Inverse() * turn_true).Log().norm(), 0.01) << "frame " << i;
+  }
+  // The second leg is tracked at a scale near the first's. Measured 0.6: the random start
+  // has 2 degrees of rotation and ~30 degrees of direction error on this purely sideways
+  // first leg (a two-view start gets it right; see docs/configuration.md), and its map's
+  // distortion shows up as a scale change once the view turns to new parts of the room.
+  const double second_leg = (poses[89]->Translation() - poses[60]->Translation()).norm();
+  EXPECT_GT(second_leg / leg, 0.4);
+  EXPECT_LT(second_leg / leg, 1.6);
+  EXPECT_LE(system.Keyframes().size(), 8u);  // no keyframe per rotated frame
 }
 
 TEST(Pipeline, SharedTumClip) {
