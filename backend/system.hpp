@@ -133,6 +133,19 @@ class System {
   // Initialisation (system_initialization.cpp).
   FrameResult StartFirstKeyframe(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
   std::vector<RevisedPose> FinishInitialisation();
+  // Choosing between two starts (start_selection.cpp).
+  struct StartSnapshot;
+  StartSnapshot SaveStart() const;
+  void RestoreStart(StartSnapshot snapshot);
+  /// Mean photometric residual (grey levels) of the buffered frames tracked against the
+  /// current map from their buffered poses; a lost frame counts as kLostFrameResidual.
+  double BufferedResidual();
+  /// Tracks the buffered frames in order against the current map, updating its depth from
+  /// each (as the random start did with its own poses).
+  void RefineWithBufferedFrames();
+  /// Builds the pair's start refined by the buffered frames and keeps whichever start has
+  /// the lower BufferedResidual.
+  void KeepTheBetterStart(const std::shared_ptr<const Frame>& pair_frame, const TwoViewPair& pair);
   FrameResult ProcessTwoViewOnly(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
   std::optional<FrameResult> ProcessWhileInitialising(const std::shared_ptr<const Frame>& frame,
                                                       const ImageU8& image,

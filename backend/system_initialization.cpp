@@ -75,7 +75,8 @@ std::vector<RevisedPose> System::FinishInitialisation() {
   std::vector<RevisedPose> revised;
   bool replaced = false;
   if (pending_pair_) {
-    // The converged random start must agree with the independent two-view geometry.
+    // The converged random start must agree with the independent two-view geometry, and
+    // then explain the frames at least as well as a start from the pair does.
     const auto& [pair_frame, pair] = *pending_pair_;
     SE3d guess;
     for (const auto& [frame, T_kf_frame] : initial_frames_) {
@@ -85,6 +86,9 @@ std::vector<RevisedPose> System::FinishInitialisation() {
     if (!T_kf_pair_frame || !RandomStartAgrees(*T_kf_pair_frame, pair)) {
       revised = StartFromPair(pair_frame, pair);
       replaced = true;
+    } else {
+      // Geometry agrees: the start whose depth explains the frames better is kept.
+      KeepTheBetterStart(pair_frame, pair);
     }
     pending_pair_.reset();
   }
