@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 #include <random>
 
+#include "tools/eval/alignment.hpp"
 #include "tools/eval/association.hpp"
 
 namespace parallax {
@@ -141,16 +142,45 @@ TEST(Evaluation, DegenerateInputsGiveClearErrors) {
     line_gt.push_back({1.0 * i, SE3d(SO3d(), Eigen::Vector3d(0.1 * i, 0, 0))});
     line_est.push_back({1.0 * i, SE3d(SO3d(), Eigen::Vector3d(0, 0.2 * i, 0))});
   }
+  // Positions alone cannot fix the turn about a straight line.
+  std::vector<Eigen::Vector3d> line_x, line_y;
+  for (std::size_t i = 0; i < line_gt.size(); ++i) {
+    line_x.push_back(line_est[i].T_w_c.Translation());
+    line_y.push_back(line_gt[i].T_w_c.Translation());
+  }
   try {
-    Evaluate(line_est, line_gt, {});
+    AlignUmeyama(line_x, line_y, AlignmentMode::kSim3);
     FAIL();
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("collinear"), std::string::npos) << e.what();
   }
+  // All estimate positions equal: nothing to align, even with orientations.
+  Trajectory still(line_est.size(), line_est.front());
+  for (std::size_t i = 0; i < still.size(); ++i) still[i].timestamp = line_est[i].timestamp;
+  EXPECT_THROW(Evaluate(still, line_gt, {}), std::invalid_argument);
   // Without alignment a straight line is fine.
   EvaluationOptions none;
   none.alignment = AlignmentMode::kNone;
   EXPECT_NEAR(Evaluate(line_est, line_gt, none).ate.max, std::hypot(0.9, 1.8), 1e-12);
+}
+
+TEST(Evaluation, StraightTrajectoryIsAlignedWithTheOrientations) {
+  // A camera sliding along a line while it turns (the rendered "rotate" motion): the
+  // positions fix scale, translation and the line; the orientations fix the turn about it.
+  const Sim3d S_gt_est(1.7, SO3d::Exp(Eigen::Vector3d(0.3, -0.5, 0.8)),
+                       Eigen::Vector3d(1.0, -2.0, 0.5));
+  Trajectory est, gt;
+  for (int i = 0; i < 30; ++i) {
+    const SE3d T_w_c(SO3d::Exp(Eigen::Vector3d(0.0, 0.02 * i, 0.01 * std::sin(0.3 * i))),
+                     Eigen::Vector3d(0.05 * i, 0.0, 0.0));
+    est.push_back({0.1 * i, T_w_c});
+    const Sim3d S_w_c = S_gt_est * Sim3d(T_w_c);
+    gt.push_back({0.1 * i, S_w_c.RigidPart()});
+  }
+  const EvaluationReport r = Evaluate(est, gt, {});
+  EXPECT_LT(r.ate.max, 1e-9);
+  EXPECT_NEAR(r.S_gt_est.Scale(), 1.7, 1e-9);
+  EXPECT_LT((r.S_gt_est.Rotation().Inverse() * S_gt_est.Rotation()).Log().norm(), 1e-9);
 }
 
 TEST(Evaluation, KittiSegmentsOnLongPath) {

@@ -1,6 +1,8 @@
 #include "tools/eval/alignment.hpp"
 
+#include <Eigen/Geometry>
 #include <Eigen/SVD>
+#include <cmath>
 #include <stdexcept>
 
 namespace parallax {
@@ -24,8 +26,27 @@ std::string ToString(AlignmentMode mode) {
   return "none";
 }
 
+namespace {
+
+/// Turns R0 about the unit axis `a` (ground-truth frame) by the angle that best aligns the
+/// orientations: maximises tr(Rot^T M), M = sum R_y_i R_x_i^T R0^T, whose dependence on the
+/// angle is cos(theta) (tr M - a^T M a) + sin(theta) tr([a]x^T M) + const.
+Eigen::Matrix3d TurnAboutLine(const Eigen::Matrix3d& R0, const Eigen::Vector3d& a,
+                              const std::vector<SO3d>& R_x, const std::vector<SO3d>& R_y) {
+  Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < R_x.size(); ++i) {
+    M += R_y[i].Matrix() * R_x[i].Matrix().transpose() * R0.transpose();
+  }
+  Eigen::Matrix3d a_x;
+  a_x << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
+  const double theta = std::atan2((a_x.transpose() * M).trace(), M.trace() - a.dot(M * a));
+  return Eigen::AngleAxisd(theta, a).toRotationMatrix() * R0;
+}
+
+}  // namespace
+
 Sim3d AlignUmeyama(const std::vector<Eigen::Vector3d>& x, const std::vector<Eigen::Vector3d>& y,
-                   AlignmentMode mode) {
+                   AlignmentMode mode, const std::vector<SO3d>& R_x, const std::vector<SO3d>& R_y) {
   if (x.size() != y.size()) throw std::invalid_argument("alignment: point counts differ");
   if (mode == AlignmentMode::kNone) return Sim3d();
   const std::size_t n = x.size();
@@ -51,13 +72,18 @@ Sim3d AlignUmeyama(const std::vector<Eigen::Vector3d>& x, const std::vector<Eige
   sigma_xy /= static_cast<double>(n);
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(sigma_xy, Eigen::ComputeFullU | Eigen::ComputeFullV);
   const Eigen::Vector3d d = svd.singularValues();
-  if (!(sigma_x2 > 0.0) || !(d[0] > 0.0) || d[1] < 1e-10 * d[0]) {
+  const bool collinear = d[1] < 1e-10 * d[0];
+  const bool oriented = R_x.size() == x.size() && R_y.size() == x.size();
+  if (!(sigma_x2 > 0.0) || !(d[0] > 0.0) || (collinear && !oriented)) {
     throw std::invalid_argument(
         "alignment is degenerate: the associated positions are (nearly) collinear or constant");
   }
   Eigen::Matrix3d S = Eigen::Matrix3d::Identity();
   if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0.0) S(2, 2) = -1.0;
-  const Eigen::Matrix3d R = svd.matrixU() * S * svd.matrixV().transpose();
+  Eigen::Matrix3d R = svd.matrixU() * S * svd.matrixV().transpose();
+  // R maps the estimate's line onto the ground truth's (first singular vectors); any turn
+  // about that line fits the positions equally, and keeps the scale tr(D S) / sigma_x^2.
+  if (collinear) R = TurnAboutLine(R, svd.matrixU().col(0), R_x, R_y);
   const double s = mode == AlignmentMode::kSim3 ? (d.asDiagonal() * S).trace() / sigma_x2 : 1.0;
   return Sim3d(s, SO3d(R), mu_y - s * R * mu_x);
 }

@@ -110,11 +110,14 @@ EvaluationReport Evaluate(const Trajectory& estimate, const Trajectory& groundtr
   report.coverage = static_cast<double>(report.matched) /
                     static_cast<double>(std::max<std::size_t>(report.groundtruth_in_span, 1));
   std::vector<Eigen::Vector3d> x, y;
+  std::vector<SO3d> R_x, R_y;  // settle the turn about the line of a straight trajectory
   for (const auto& p : pairs) {
     x.push_back(estimate[p.estimate_index].T_w_c.Translation());
     y.push_back(groundtruth[p.groundtruth_index].T_w_c.Translation());
+    R_x.push_back(estimate[p.estimate_index].T_w_c.Rotation());
+    R_y.push_back(groundtruth[p.groundtruth_index].T_w_c.Rotation());
   }
-  report.S_gt_est = AlignUmeyama(x, y, options.alignment);
+  report.S_gt_est = AlignUmeyama(x, y, options.alignment, R_x, R_y);
   std::vector<double> ate;
   std::vector<SE3d> est, gt;
   std::vector<double> times;
