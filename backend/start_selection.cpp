@@ -90,7 +90,11 @@ void System::KeepTheBetterStart(const std::shared_ptr<const Frame>& pair_frame,
   StartFromPair(pair_frame, pair);
   RefineWithBufferedFrames();
   const double pair_residual = BufferedResidual();
-  if (!(pair_residual < random_residual)) RestoreStart(std::move(random_start));
+  // Near-equal residuals are no evidence against the random start, whose depth has seen the
+  // frames live: the pair must be clearly better.
+  if (!(pair_residual < options_.auto_pair_residual_ratio * random_residual)) {
+    RestoreStart(std::move(random_start));
+  }
 }
 
 }  // namespace parallax

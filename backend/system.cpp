@@ -40,6 +40,8 @@ void SystemOptions::Check() const {
   CheckOption(auto_max_rotation_deg > 0.0, "SystemOptions", "auto_max_rotation_deg", "must be > 0");
   CheckOption(auto_max_direction_deg > 0.0, "SystemOptions", "auto_max_direction_deg",
               "must be > 0");
+  CheckOption(auto_pair_residual_ratio > 0.0, "SystemOptions", "auto_pair_residual_ratio",
+              "must be > 0");
   CheckOption(restart_after_lost >= 1, "SystemOptions", "restart_after_lost", "must be >= 1");
   CheckOption(keyframe_distance > 0.0, "SystemOptions", "keyframe_distance", "must be > 0");
   CheckOption(min_keyframe_usage >= 0.0 && min_keyframe_usage <= 1.0, "SystemOptions",
