@@ -134,14 +134,14 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const TrackingR
   // Distance relative to the mean depth (mean idepth is 1 after normalisation).
   const double relative_distance =
       tracked.T_kf_frame.Translation().norm() * map_->MeanSmoothedIdepth();
-  // The distance of an unconverged random start means little: while a two-view pair is
-  // sought, only a failing view ends the first keyframe; once a pair is held it stays.
+  // While a two-view pair is sought or held the first keyframe stays: the random start it
+  // would be compared with, or replaced by, lives in that keyframe.
+  const bool start_pending = bootstrap_ || pending_pair_;
   const bool view_degrades = tracked.stats.usage < options_.min_keyframe_usage ||
                              tracked.stats.good_ratio < options_.min_keyframe_good_ratio;
-  const bool distance_counts = !bootstrap_ && !pending_pair_;
-  const bool want_keyframe =
-      !bootstrap_ && !pending_pair_ && frames_in_keyframe_ >= options_.min_frames_per_keyframe &&
-      (view_degrades || (distance_counts && relative_distance > options_.keyframe_distance));
+  const bool want_keyframe = !start_pending &&
+                             frames_in_keyframe_ >= options_.min_frames_per_keyframe &&
+                             (view_degrades || relative_distance > options_.keyframe_distance);
   if (tracked.status == TrackingStatus::kOk && relative_distance > options_.min_update_baseline) {
     const StereoFrame stereo{frame.get(), tracked.T_kf_frame.Inverse(), tracked.affine.Gain(),
                              tracked.affine.b, static_cast<float>(1.0 - tracked.stats.good_ratio)};

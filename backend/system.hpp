@@ -162,7 +162,9 @@ class System {
   /// the newest frame's.
   std::vector<RevisedPose> StartFromPair(const std::shared_ptr<const Frame>& pair_frame,
                                          const TwoViewPair& pair);
-  void StartRandom(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
+  /// `map`: the keyframe's map before any depth (it is initialised randomly here).
+  void StartRandom(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
+                   InverseDepthMap map);
 
   PinholeCamera camera_;
   SystemOptions options_;

@@ -1,13 +1,14 @@
 // System: the start of a sequence (design.md section 3a, docs/configuration.md).
 
 #include <cmath>
+#include <numbers>
 
 #include "backend/system.hpp"
 
 namespace parallax {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 
 double AngleBetweenDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const double norms = a.norm() * b.norm();
@@ -20,7 +21,8 @@ double AngleBetweenDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 FrameResult System::StartFirstKeyframe(const std::shared_ptr<const Frame>& frame,
                                        const ImageU8& image) {
   FrameResult result;
-  const double textured = static_cast<double>(InverseDepthMap(frame, options_.depth).NumEligible());
+  InverseDepthMap map(frame, options_.depth);
+  const auto textured = static_cast<double>(map.NumEligible());
   if (textured < options_.min_start_texture * static_cast<double>(image.NumPixels())) {
     // A covered lens, a dark room or a blank wall: no keyframe, no pose; try the next frame.
     result.stats.reason = "too little texture to start";
@@ -28,12 +30,12 @@ FrameResult System::StartFirstKeyframe(const std::shared_ptr<const Frame>& frame
   }
   if (options_.initialization == Initialization::kTwoView) {
     // Keyframe with an empty map; its depth comes from the first good two-view pair.
-    StartKeyframe(frame, Sim3d(), InverseDepthMap(frame, options_.depth));
+    StartKeyframe(frame, Sim3d(), std::move(map));
     bootstrap_ = std::make_unique<TwoViewBootstrap>(camera_, options_.bootstrap);
     bootstrap_->SetReference(image);
     bootstrap_tries_ = 0;
   } else {
-    StartRandom(frame, image);
+    StartRandom(frame, image, std::move(map));
   }
   result.status = TrackingStatus::kOk;
   result.T_w_c = SE3d();
@@ -41,9 +43,9 @@ FrameResult System::StartFirstKeyframe(const std::shared_ptr<const Frame>& frame
   return result;
 }
 
-void System::StartRandom(const std::shared_ptr<const Frame>& frame, const ImageU8& image) {
+void System::StartRandom(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
+                         InverseDepthMap map) {
   // LSD-style start: random inverse depth (mean 1) that the first frames refine.
-  InverseDepthMap map(frame, options_.depth);
   map.InitializeRandom(1.0f);
   StartKeyframe(frame, Sim3d(), std::move(map));
   depth_updates_ = 0;
@@ -122,7 +124,7 @@ FrameResult System::ProcessTwoViewOnly(const std::shared_ptr<const Frame>& frame
     // No usable pair: start over from random depth at this frame; the frames before it stay
     // without a pose.
     initial_frames_.clear();
-    StartRandom(frame, image);
+    StartRandom(frame, image, InverseDepthMap(frame, options_.depth));
     result.status = TrackingStatus::kOk;
     result.T_w_c = SE3d();
     result.is_keyframe = true;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/features2d.hpp>
@@ -86,7 +87,7 @@ void TwoViewBootstrap::SetReference(const ImageU8& image) {
 
 namespace {
 
-constexpr double kDegPerRad = 57.295779513082320876;
+constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 
 struct Matches {
   std::vector<cv::Point2d> ref, cur;

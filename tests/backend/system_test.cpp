@@ -9,11 +9,11 @@
 #include <sstream>
 
 #include "tests/tools/temp_dir.hpp"
+#include "tests/tracking/render_fixture.hpp"
 #include "tools/dataset/input_error.hpp"
 #include "tools/dataset/trajectory.hpp"
 #include "tools/eval/evaluation.hpp"
 #include "tools/run_pipeline.hpp"
-#include "tools/synth/random.hpp"
 #include "tools/synth/renderer.hpp"
 #include "tools/synth/scene.hpp"
 #include "tools/synth/synthetic_sequence.hpp"
@@ -129,25 +129,22 @@ INSTANTIATE_TEST_SUITE_P(
              (c.exposure ? "_exposure" : "");
     });
 
+/// The rendered room seen from its start pose moved by T_start_c (TestCamera(), which is the
+/// synthetic camera), times `gain`, plus Gaussian noise.
+ImageU8 RenderRoom(const SE3d& T_start_c, float gain, double noise_sigma, std::uint64_t seed) {
+  static const synth::Scene scene = synth::MakeScene("room", 1);
+  return test::RenderTestImage(scene, synth::FramePose({}, scene, 0) * T_start_c, gain, noise_sigma,
+                               seed);
+}
+
 /// 60 frames of a sideways pan through the rendered room (1.2 m, 36 degrees), then a jump
 /// back to 2-8 cm from the start (as after a dropped stretch of video); returns how many of
 /// the 10 frames after the jump were tracked, checking their rotations.
 int TrackedAfterJumpBack(int recent_keyframes) {
-  const synth::Scene scene = synth::MakeScene("room", 1);
-  const PinholeCamera camera = synth::SynthCamera({});
-  const SE3d T_w_start = synth::FramePose({}, scene, 0);
   SystemOptions options;
   options.recent_keyframes = recent_keyframes;
-  System system(camera, options);
-  auto render = [&](const SE3d& T_start_c) {
-    const synth::RenderedView view = synth::Render(scene, camera, T_w_start * T_start_c);
-    ImageU8 image(camera.Width(), camera.Height());
-    for (std::size_t i = 0; i < image.NumPixels(); ++i) {
-      image.Data()[i] = static_cast<std::uint8_t>(
-          std::lround(std::clamp(view.intensity.Data()[i], 0.0f, 255.0f)));
-    }
-    return image;
-  };
+  System system(synth::SynthCamera({}), options);
+  auto render = [](const SE3d& T_start_c) { return RenderRoom(T_start_c, 1.0f, 0.0, 1); };
   auto pan = [](double i) {  // 2 cm and 0.6 degrees per frame, with a little bob
     return SE3d(SO3d::Exp(Eigen::Vector3d(0.0, 0.0105 * i, 0.0)),
                 Eigen::Vector3d(0.02 * i, 0.004 * std::sin(0.7 * i), 0.0));
@@ -178,26 +175,11 @@ TEST(Pipeline, LostFramesAreRecoveredOnRecentKeyframes) {
   EXPECT_EQ(TrackedAfterJumpBack(0), 0);
 }
 
-/// The rendered room at the start pose moved by T_start_c, with Gaussian noise, times `gain`.
-ImageU8 RenderRoom(const SE3d& T_start_c, double gain, double noise_sigma, std::uint64_t seed) {
-  static const synth::Scene scene = synth::MakeScene("room", 1);
-  const PinholeCamera camera = synth::SynthCamera({});
-  const synth::RenderedView view =
-      synth::Render(scene, camera, synth::FramePose({}, scene, 0) * T_start_c);
-  synth::Random rng(seed);
-  ImageU8 image(camera.Width(), camera.Height());
-  for (std::size_t i = 0; i < image.NumPixels(); ++i) {
-    const double v = gain * view.intensity.Data()[i] + noise_sigma * rng.Normal();
-    image.Data()[i] = static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 255.0)));
-  }
-  return image;
-}
-
 TEST(Pipeline, StaticCameraInventsNoMotionAndNoKeyframes) {
   System system(synth::SynthCamera({}));
   for (int i = 0; i < 200; ++i) {
     const FrameResult r = system.ProcessFrame(
-        RenderRoom(SE3d(), 1.0, 2.0, 100u + static_cast<std::uint64_t>(i)), i / 30.0);
+        RenderRoom(SE3d(), 1.0f, 2.0, 100u + static_cast<std::uint64_t>(i)), i / 30.0);
     ASSERT_TRUE(r.T_w_c.has_value()) << "frame " << i;
     EXPECT_LT(r.T_w_c->Translation().norm(), 0.003) << "frame " << i;
   }
@@ -218,7 +200,7 @@ TEST(Pipeline, DarkStartGivesNoPosesThenInitialises) {
     const SE3d T_start_c =
         dark ? SE3d() : T_w_start.Inverse() * synth::FramePose(shake, scene, i - 20);
     const FrameResult r = system.ProcessFrame(
-        RenderRoom(T_start_c, dark ? 0.02 : 1.0, 1.0, static_cast<std::uint64_t>(i)), i / 30.0);
+        RenderRoom(T_start_c, dark ? 0.02f : 1.0f, 1.0, static_cast<std::uint64_t>(i)), i / 30.0);
     poses.push_back(r.T_w_c);
     for (const RevisedPose& revised : r.revised) {
       poses[static_cast<std::size_t>(revised.frame_id)] = revised.T_w_c;
@@ -244,7 +226,7 @@ TEST(Pipeline, PureRotationKeepsThePositionAndTheMap) {
   for (int i = 0; i < rotate.frames; ++i) {
     truth.push_back(T_w_start.Inverse() * synth::FramePose(rotate, scene, i));
     const FrameResult r =
-        system.ProcessFrame(RenderRoom(truth.back(), 1.0, 1.0, static_cast<std::uint64_t>(i)),
+        system.ProcessFrame(RenderRoom(truth.back(), 1.0f, 1.0, static_cast<std::uint64_t>(i)),
                             synth::FrameTimestamp(rotate, i));
     poses.push_back(r.T_w_c);
     for (const RevisedPose& revised : r.revised) {

@@ -5,16 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 
-#include "tools/synth/random.hpp"
-#include "tools/synth/renderer.hpp"
-#include "tools/synth/scene.hpp"
-#include "tools/synth/synthetic_sequence.hpp"
+#include "tests/tracking/render_fixture.hpp"
 
 namespace parallax {
 namespace {
 
-constexpr double kDegPerRad = 57.295779513082320876;
+constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 
 class TwoViewBootstrapTest : public ::testing::Test {
  protected:
@@ -23,16 +21,8 @@ class TwoViewBootstrapTest : public ::testing::Test {
         camera_(synth::SynthCamera({})),
         T_w_ref_(synth::FramePose({}, scene_, 0)) {}
 
-  /// The scene seen from T_w_c, times `gain`, plus Gaussian noise, as 8 bits.
-  ImageU8 RenderImage(const SE3d& T_w_c, double gain, double noise_sigma) const {
-    const synth::RenderedView view = synth::Render(scene_, camera_, T_w_c);
-    synth::Random rng(7);
-    ImageU8 image(camera_.Width(), camera_.Height());
-    for (std::size_t i = 0; i < image.NumPixels(); ++i) {
-      const double v = gain * view.intensity.Data()[i] + noise_sigma * rng.Normal();
-      image.Data()[i] = static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 255.0)));
-    }
-    return image;
+  ImageU8 RenderImage(const SE3d& T_w_c, float gain, double noise_sigma) const {
+    return test::RenderTestImage(scene_, T_w_c, gain, noise_sigma, 7);
   }
 
   /// Frame pose after moving by `T_ref_frame` (camera motion in the reference frame).
@@ -49,8 +39,8 @@ TEST_F(TwoViewBootstrapTest, RecoversRotationTranslationDirectionAndGain) {
   const SE3d T_ref_frame(SO3d::Exp(Eigen::Vector3d(0.0, 3.0 / kDegPerRad, 0.0)),
                          Eigen::Vector3d(0.20, 0.0, 0.05));
   TwoViewBootstrap bootstrap(camera_);
-  bootstrap.SetReference(RenderImage(T_w_ref_, 1.0, 1.0));
-  const auto pair = bootstrap.TryFrame(RenderImage(Moved(T_ref_frame), 1.2, 1.0));
+  bootstrap.SetReference(RenderImage(T_w_ref_, 1.0f, 1.0));
+  const auto pair = bootstrap.TryFrame(RenderImage(Moved(T_ref_frame), 1.2f, 1.0));
   ASSERT_TRUE(pair.has_value());
   const SE3d T_frame_ref_true = T_ref_frame.Inverse();
   const double rotation_error_deg =
@@ -77,18 +67,18 @@ TEST_F(TwoViewBootstrapTest, RecoversRotationTranslationDirectionAndGain) {
 
 TEST_F(TwoViewBootstrapTest, RejectsPairsWithoutParallax) {
   TwoViewBootstrap bootstrap(camera_);
-  bootstrap.SetReference(RenderImage(T_w_ref_, 1.0, 1.0));
+  bootstrap.SetReference(RenderImage(T_w_ref_, 1.0f, 1.0));
   // Pure rotation: many matches, no triangulation angle.
   const SE3d rotated(SO3d::Exp(Eigen::Vector3d(0.02, 0.05, 0.0)), Eigen::Vector3d::Zero());
-  EXPECT_FALSE(bootstrap.TryFrame(RenderImage(Moved(rotated), 1.0, 1.0)).has_value());
+  EXPECT_FALSE(bootstrap.TryFrame(RenderImage(Moved(rotated), 1.0f, 1.0)).has_value());
   // A 5 mm step: parallax far below the threshold.
   const SE3d step(SO3d(), Eigen::Vector3d(0.005, 0.0, 0.0));
-  EXPECT_FALSE(bootstrap.TryFrame(RenderImage(Moved(step), 1.0, 1.0)).has_value());
+  EXPECT_FALSE(bootstrap.TryFrame(RenderImage(Moved(step), 1.0f, 1.0)).has_value());
 }
 
 TEST_F(TwoViewBootstrapTest, RejectsATexturelessFrame) {
   TwoViewBootstrap bootstrap(camera_);
-  bootstrap.SetReference(RenderImage(T_w_ref_, 1.0, 1.0));
+  bootstrap.SetReference(RenderImage(T_w_ref_, 1.0f, 1.0));
   EXPECT_FALSE(bootstrap.TryFrame(ImageU8(camera_.Width(), camera_.Height(), 90)).has_value());
 }
 

@@ -21,11 +21,10 @@ struct RenderedKeyframe {
 
 inline PinholeCamera TestCamera() { return PinholeCamera(640, 480, 525.0, 525.0, 319.5, 239.5); }
 
-/// Renders the scene at T_w_c with brightness gain and Gaussian noise.
-inline std::shared_ptr<const Frame> RenderTestFrame(const synth::Scene& scene, const SE3d& T_w_c,
-                                                    std::int64_t id, float gain = 1.0f,
-                                                    double noise_sigma = 0.0,
-                                                    std::uint64_t seed = 1) {
+/// The scene seen from T_w_c by TestCamera() (= synth::SynthCamera({})) as 8 bits: intensity
+/// times `gain`, plus Gaussian noise, rounded and clipped.
+inline ImageU8 RenderTestImage(const synth::Scene& scene, const SE3d& T_w_c, float gain = 1.0f,
+                               double noise_sigma = 0.0, std::uint64_t seed = 1) {
   const PinholeCamera K = TestCamera();
   const synth::RenderedView view = synth::Render(scene, K, T_w_c);
   synth::Random rng(seed);
@@ -35,7 +34,16 @@ inline std::shared_ptr<const Frame> RenderTestFrame(const synth::Scene& scene, c
     if (noise_sigma > 0.0) v += noise_sigma * rng.Normal();
     image.Data()[i] = static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 255.0)));
   }
-  return std::make_shared<const Frame>(id, 0.0, K, image);
+  return image;
+}
+
+/// Renders the scene at T_w_c with brightness gain and Gaussian noise.
+inline std::shared_ptr<const Frame> RenderTestFrame(const synth::Scene& scene, const SE3d& T_w_c,
+                                                    std::int64_t id, float gain = 1.0f,
+                                                    double noise_sigma = 0.0,
+                                                    std::uint64_t seed = 1) {
+  return std::make_shared<const Frame>(id, 0.0, TestCamera(),
+                                       RenderTestImage(scene, T_w_c, gain, noise_sigma, seed));
 }
 
 /// A keyframe with ground-truth inverse depth (relative sigma 1%), excluding pixels at depth
