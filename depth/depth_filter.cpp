@@ -49,7 +49,7 @@ void DepthFilter::UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search
   } else {
     const float mid = std::sqrt(options_.min_idepth * options_.max_idepth);
     obs = search.Observe(x, y, options_.min_idepth, options_.max_idepth, mid,
-                         4.0f * options_.max_search_length);
+                         options_.max_search_length_new);
   }
   switch (obs.status) {
     case StereoStatus::kOk:

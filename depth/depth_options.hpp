@@ -33,11 +33,18 @@ struct DepthFilterOptions {
   /// Longest searched epipolar segment for a pixel with a prior, pixels.
   float max_search_length = 30.0f;
   /// Longest segment of the full-range search for a new pixel, pixels (centred on the
-  /// geometric mean of min/max inverse depth).
-  float max_search_length_new = 60.0f;
+  /// geometric mean of min/max inverse depth, moved inside the frame).
+  float max_search_length_new = 120.0f;
+  /// Shortest searched segment, pixels (LSD-SLAM's MIN_EPL_LENGTH_CROP); every segment is also
+  /// padded by a pixel beyond each end of the prior's range.
+  float min_search_length = 3.0f;
   /// Gates: squared gradient along the epipolar line >= this, and its share of |grad|^2.
   float min_gradient_along_line_sq = 4.0f;
   float min_gradient_along_line_share = 0.09f;
+  /// Uncertainty of a tracked frame's baseline, in the map's units (mean depth 1 after
+  /// normalisation): adds (idepth * baseline_sigma / |t|)^2 to an observation's variance, so
+  /// tiny baselines, whose pose error is a large share of the baseline, count for little.
+  float baseline_sigma = 0.001f;
   /// Allowed change of the apparent pattern scale between keyframe and frame.
   float min_rescale = 0.7f;
   float max_rescale = 1.4f;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 namespace parallax {
 namespace {
@@ -70,33 +71,45 @@ StereoObservation EpipolarSearch::Observe(int x, int y, float min_idepth, float 
   } else {
     dir /= length;
   }
-  // Clip [far, near] to the part of the frame where the 5-sample pattern fits.
-  const float lo = 2.0f + kPatternHalf, hi_x = w - 3.0f - kPatternHalf,
-              hi_y = h - 3.0f - kPatternHalf;
-  float s0 = 0.0f, s1 = length;
-  for (int axis = 0; axis < 2; ++axis) {
-    const float p0 = far[axis], d = dir[axis], hi = axis == 0 ? hi_x : hi_y;
-    if (std::abs(d) < 1e-9f) {
-      if (p0 < lo || p0 > hi) s1 = -1.0f;
-      continue;
-    }
-    float a = (lo - p0) / d, b = (hi - p0) / d;
-    if (a > b) std::swap(a, b);
-    s0 = std::max(s0, a);
-    s1 = std::min(s1, b);
-  }
-  if (s1 < s0) {
-    out.status = StereoStatus::kOutOfImage;
-    return out;
-  }
-  // Centre a capped window on the expected inverse depth.
-  if (s1 - s0 > max_length) {
+  // Searched interval along far + s * dir: the prior's segment padded by a pixel beyond each
+  // end (a match on the prior's boundary must be an interior minimum for the sub-pixel fit; on
+  // a short segment the first sample would otherwise sit on the far end and pull the estimate
+  // there) and to at least min_search_length, centred (LSD-SLAM's MIN_EPL_LENGTH_CROP).
+  const float pad = 1.0f + 0.5f * std::max(0.0f, options_.min_search_length - length - 2.0f);
+  const float full_s0 = -pad, full_s1 = length + pad;
+  float s0 = full_s0, s1 = full_s1;
+  if (s1 - s0 > max_length) {  // a window centred on the expected inverse depth
     const Eigen::Vector2f expected = project(expected_idepth);
     const float centre =
         std::clamp((expected - far).dot(dir), s0 + 0.5f * max_length, s1 - 0.5f * max_length);
     s0 = centre - 0.5f * max_length;
     s1 = centre + 0.5f * max_length;
   }
+  // The window must fit where the 5-sample pattern fits in the frame. A window cut by the border
+  // may have lost the true match and would return the best wrong one left inside (fast forward
+  // motion: near points leave the frame and came back as far ones); DSO drops such points too.
+  const float lo = 2.0f + kPatternHalf, hi_x = w - 3.0f - kPatternHalf,
+              hi_y = h - 3.0f - kPatternHalf;
+  float in0 = -std::numeric_limits<float>::infinity(), in1 = -in0;  // s-range inside the frame
+  for (int axis = 0; axis < 2; ++axis) {
+    const float p0 = far[axis], d = dir[axis], hi = axis == 0 ? hi_x : hi_y;
+    if (std::abs(d) < 1e-9f) {
+      if (p0 < lo || p0 > hi) in1 = -std::numeric_limits<float>::infinity();
+      continue;
+    }
+    float a = (lo - p0) / d, b = (hi - p0) / d;
+    if (a > b) std::swap(a, b);
+    in0 = std::max(in0, a);
+    in1 = std::min(in1, b);
+  }
+  if (s0 < in0 || s1 > in1 || s1 < s0) {
+    out.status = StereoStatus::kOutOfImage;
+    return out;
+  }
+  // A best match at an end of a window narrower than the padded segment is no minimum: the
+  // true one may lie beyond.
+  const bool far_end_open = s0 > full_s0, near_end_open = s1 < full_s1;
+  s0 += 0.5f * (s1 - s0 - std::floor(s1 - s0));  // whole-pixel steps, centred in the window
   // Comparison pattern: 5 keyframe samples along the line, ordered and spaced so that they
   // map onto 1-pixel steps along the frame's line at the expected depth.
   const Eigen::Vector2f x_kf(static_cast<float>(x), static_cast<float>(y));
@@ -139,6 +152,11 @@ StereoObservation EpipolarSearch::Observe(int x, int y, float min_idepth, float 
     if (best < 0 || e < ssd[Idx(best)]) best = j;
   }
   out.search_length = s1 - s0;
+  if ((best == 0 && far_end_open) || (best == num_positions - 1 && near_end_open) ||
+      (positions > num_positions && best == num_positions - 1)) {
+    out.status = StereoStatus::kNoMatch;
+    return out;
+  }
   const float best_ssd = ssd[Idx(best)];
   // Frame gradient along the line over the matched pattern (for the photometric error).
   float g_frame_sq = 0.0f;
@@ -181,13 +199,16 @@ StereoObservation EpipolarSearch::Observe(int x, int y, float min_idepth, float 
     return out;
   }
   // Disparity variance: epipolar line error projected on the gradient, image noise over the
-  // gradient along the line, and sub-pixel discretisation (docs/math/depth_filter.md).
+  // gradient along the line, and sub-pixel discretisation (docs/math/depth_filter.md); plus the
+  // baseline's own uncertainty, which scales the inverse depth as a whole (d ~ 1 / |t|).
   const float geometric = line_sigma_sq_ * g_sq / (g_line * g_line);
   const float photometric =
       2.0f * options_.pixel_noise_sigma * options_.pixel_noise_sigma / std::max(g_frame_sq, 1.0f);
+  const float baseline_relative = options_.baseline_sigma / std::max(t_.norm(), 1e-9f);
   out.status = StereoStatus::kOk;
   out.idepth = d;
-  out.variance = alpha * alpha * (geometric + photometric + 0.05f);
+  out.variance = alpha * alpha * (geometric + photometric + 0.05f) +
+                 d * d * baseline_relative * baseline_relative;
   return out;
 }
 

@@ -43,7 +43,10 @@ class EpipolarSearch {
 
   /// Searches keyframe pixel (x, y) for inverse depths in [min_idepth, max_idepth] (the prior
   /// mu +- 2 sigma, or the full range for a new pixel); `expected_idepth` (> 0) orients and
-  /// scales the comparison pattern, and `max_length` caps the searched segment (pixels).
+  /// scales the comparison pattern, and `max_length` caps the searched segment (pixels): a
+  /// window centred on the expected depth. The segment is padded by a pixel beyond each end
+  /// and to at least options.min_search_length; a window that does not fit inside the frame is
+  /// kOutOfImage (docs/math/depth_filter.md, "Searched segment").
   StereoObservation Observe(int x, int y, float min_idepth, float max_idepth, float expected_idepth,
                             float max_length) const;
 

@@ -43,6 +43,8 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"pixel_noise_sigma", Set(&o->depth.pixel_noise_sigma)},
         {"max_search_length", Set(&o->depth.max_search_length)},
         {"max_search_length_new", Set(&o->depth.max_search_length_new)},
+        {"min_search_length", Set(&o->depth.min_search_length)},
+        {"baseline_sigma", Set(&o->depth.baseline_sigma)},
         {"max_variance", Set(&o->depth.max_variance)},
         {"seed", Set(&o->depth.seed)}}},
       {"system",
