@@ -33,7 +33,7 @@ struct DepthFilterOptions {
   /// Longest searched epipolar segment for a pixel with a prior, pixels.
   float max_search_length = 30.0f;
   /// Longest segment of the full-range search for a new pixel, pixels (centred on the
-  /// geometric mean of min/max inverse depth, moved inside the frame).
+  /// geometric mean of min/max inverse depth; like every window it must fit in the frame).
   float max_search_length_new = 120.0f;
   /// Shortest searched segment, pixels (LSD-SLAM's MIN_EPL_LENGTH_CROP); every segment is also
   /// padded by a pixel beyond each end of the prior's range.

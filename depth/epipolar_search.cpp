@@ -87,7 +87,7 @@ StereoObservation EpipolarSearch::Observe(int x, int y, float min_idepth, float 
   }
   // The window must fit where the 5-sample pattern fits in the frame. A window cut by the border
   // may have lost the true match and would return the best wrong one left inside (fast forward
-  // motion: near points leave the frame and came back as far ones); DSO drops such points too.
+  // motion: near points leave the frame and would come back as far ones); DSO drops them too.
   const float lo = 2.0f + kPatternHalf, hi_x = w - 3.0f - kPatternHalf,
               hi_y = h - 3.0f - kPatternHalf;
   float in0 = -std::numeric_limits<float>::infinity(), in1 = -in0;  // s-range inside the frame
