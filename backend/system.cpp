@@ -35,6 +35,7 @@ void SystemOptions::Check() const {
   reference.Check();
   tracker.Check();
   depth.Check();
+  update_direction.Check();
   bootstrap.Check();
   CheckOption(bootstrap_max_frames >= 1, "SystemOptions", "bootstrap_max_frames", "must be >= 1");
   CheckOption(auto_max_rotation_deg > 0.0, "SystemOptions", "auto_max_rotation_deg", "must be > 0");
@@ -58,7 +59,11 @@ void SystemOptions::Check() const {
 }
 
 System::System(const PinholeCamera& camera, const SystemOptions& options)
-    : camera_(camera), options_(options), tracker_(options.tracker), depth_filter_(options.depth) {
+    : camera_(camera),
+      options_(options),
+      tracker_(options.tracker),
+      depth_filter_(options.depth),
+      update_direction_(camera, options.update_direction) {
   options_.Check();
 }
 
@@ -108,7 +113,7 @@ FrameResult System::ProcessFrame(const ImageU8& image, double timestamp) {
   if (initialised_at_frame_ < 0) {
     if (auto handled = ProcessWhileInitialising(frame, image, tracked)) return *handled;
   }
-  if (tracked.status != TrackingStatus::kLost) MapFrame(frame, tracked, &result);
+  if (tracked.status != TrackingStatus::kLost) MapFrame(frame, image, tracked, &result);
   return result;
 }
 
@@ -128,8 +133,8 @@ TrackingResult System::TrackFrame(const Frame& frame, FrameResult* result) {
   return tracked;
 }
 
-void System::MapFrame(const std::shared_ptr<const Frame>& frame, const TrackingResult& tracked,
-                      FrameResult* result) {
+void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
+                      const TrackingResult& tracked, FrameResult* result) {
   const auto start = Clock::now();
   // Distance relative to the mean depth (mean idepth is 1 after normalisation).
   const double relative_distance =
@@ -143,7 +148,12 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const TrackingR
                              frames_in_keyframe_ >= options_.min_frames_per_keyframe &&
                              (view_degrades || relative_distance > options_.keyframe_distance);
   if (tracked.status == TrackingStatus::kOk && relative_distance > options_.min_update_baseline) {
-    const StereoFrame stereo{frame.get(), tracked.T_kf_frame.Inverse(), tracked.affine.Gain(),
+    // Only once initialised: the start's keyframe and its selection stay as they were.
+    const SE3d T_kf_update = initialised_at_frame_ < 0
+                                 ? tracked.T_kf_frame
+                                 : update_direction_.Refine(map_->KeyframePtr()->Id(), image,
+                                                            tracked.T_kf_frame, relative_distance);
+    const StereoFrame stereo{frame.get(), T_kf_update.Inverse(), tracked.affine.Gain(),
                              tracked.affine.b, static_cast<float>(1.0 - tracked.stats.good_ratio)};
     depth_filter_.Update(map_.get(), stereo);
     ++depth_updates_;
@@ -165,6 +175,7 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const TrackingR
     const Sim3d S_w_c = S_w_kf_ * Sim3d(tracked.T_kf_frame);
     const SE3d velocity(T_prev_last_.Rotation(), T_prev_last_.Translation() / s);
     StartKeyframe(frame, S_w_c * Sim3d(s, SO3d(), Eigen::Vector3d::Zero()), std::move(next));
+    update_direction_.SetKeyframe(frame->Id(), image);
     T_prev_last_ = velocity;  // constant-velocity guess for the next frame, new keyframe units
     affine_ = AffineBrightness{};
     result->is_keyframe = true;
@@ -192,6 +203,7 @@ std::optional<TrackingResult> System::TrackRecentKeyframes(const Frame& frame) {
     std::swap(reference_, it->reference);
     std::swap(S_w_kf_, it->S_w_kf);
     std::rotate(recent_.begin(), it, std::next(it));
+    update_direction_.Reset();  // its features are of the keyframe left behind
     T_kf_last_ = r.T_kf_frame;
     T_prev_last_ = SE3d();
     affine_ = r.affine;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "backend/two_view_bootstrap.hpp"
+#include "backend/update_direction.hpp"
 #include "core/frame.hpp"
 #include "core/image.hpp"
 #include "core/pinhole_camera.hpp"
@@ -52,6 +53,8 @@ struct SystemOptions {
   TrackingReferenceOptions reference;
   Se3TrackerOptions tracker;
   DepthFilterOptions depth;
+  /// Translation direction of the depth updates' poses checked against the essential matrix.
+  UpdateDirectionOptions update_direction;
   /// New keyframe when |t_kf_frame| * mean idepth (distance relative to the mean depth)
   /// exceeds this, or when fewer than `min_keyframe_usage` of the keyframe points are in view.
   double keyframe_distance = 0.15;
@@ -132,8 +135,8 @@ class System {
   /// SystemOptions::recent_keyframes); on success the found keyframe is current again.
   std::optional<TrackingResult> TrackRecentKeyframes(const Frame& frame);
   TrackingResult TrackFrame(const Frame& frame, FrameResult* result);
-  void MapFrame(const std::shared_ptr<const Frame>& frame, const TrackingResult& tracked,
-                FrameResult* result);
+  void MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
+                const TrackingResult& tracked, FrameResult* result);
   // Initialisation (system_initialization.cpp).
   FrameResult StartFirstKeyframe(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
   std::vector<RevisedPose> FinishInitialisation();
@@ -170,6 +173,7 @@ class System {
   SystemOptions options_;
   Se3Tracker tracker_;
   DepthFilter depth_filter_;
+  UpdateDirection update_direction_;
   std::unique_ptr<InverseDepthMap> map_;
   std::unique_ptr<TrackingReference> reference_;
   std::vector<KeyframeRecord> keyframes_;

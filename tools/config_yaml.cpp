@@ -77,7 +77,11 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"min_frames_per_keyframe", Set(&o->min_frames_per_keyframe)},
         {"recent_keyframes", Set(&o->recent_keyframes)},
         {"max_buffered_frames", Set(&o->max_buffered_frames)},
-        {"initialization_updates", Set(&o->initialization_updates)}}},
+        {"initialization_updates", Set(&o->initialization_updates)},
+        {"update_direction", Set(&o->update_direction.enabled)},
+        {"update_direction_weight", Set(&o->update_direction.essential_weight)},
+        {"update_direction_max_angle_deg", Set(&o->update_direction.max_angle_deg)},
+        {"update_direction_min_baseline", Set(&o->update_direction.min_relative_baseline)}}},
   };
 }
 

@@ -1,0 +1,68 @@
+#include "backend/update_direction.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "core/check.hpp"
+
+namespace parallax {
+
+void UpdateDirectionOptions::Check() const {
+  const char* s = "UpdateDirectionOptions";
+  CheckOption(min_relative_baseline >= 0.0, s, "min_relative_baseline", "must be >= 0");
+  CheckOption(essential_weight >= 0.0 && essential_weight <= 1.0, s, "essential_weight",
+              "must be in [0, 1]");
+  CheckOption(max_angle_deg > 0.0 && max_angle_deg <= 180.0, s, "max_angle_deg",
+              "must be in (0, 180]");
+  matcher.Check();
+}
+
+Eigen::Vector3d BlendDirections(const Eigen::Vector3d& tracked, const Eigen::Vector3d& essential,
+                                double weight, double max_angle_deg) {
+  const double n_t = tracked.norm(), n_e = essential.norm();
+  if (!(n_t > 0.0) || !(n_e > 0.0)) return tracked;
+  const Eigen::Vector3d u_t = tracked / n_t, u_e = essential / n_e;
+  const double angle_deg =
+      std::acos(std::clamp(u_t.dot(u_e), -1.0, 1.0)) * 180.0 / std::numbers::pi;
+  if (angle_deg > max_angle_deg) return tracked;
+  const Eigen::Vector3d blend = weight * u_e + (1.0 - weight) * u_t;
+  return blend.normalized() * n_t;
+}
+
+UpdateDirection::UpdateDirection(const PinholeCamera& camera, const UpdateDirectionOptions& options)
+    : options_(options), camera_(camera) {
+  options_.Check();
+}
+
+UpdateDirection::~UpdateDirection() = default;
+UpdateDirection::UpdateDirection(UpdateDirection&&) noexcept = default;
+UpdateDirection& UpdateDirection::operator=(UpdateDirection&&) noexcept = default;
+
+void UpdateDirection::SetKeyframe(std::int64_t keyframe_id, const ImageU8& image) {
+  if (!options_.enabled) return;
+  if (!pairs_) pairs_ = std::make_unique<TwoViewBootstrap>(camera_, options_.matcher);
+  pairs_->SetReference(image);
+  keyframe_id_ = keyframe_id;
+}
+
+void UpdateDirection::Reset() { keyframe_id_ = -1; }
+
+SE3d UpdateDirection::Refine(std::int64_t keyframe_id, const ImageU8& frame, const SE3d& T_kf_frame,
+                             double relative_baseline) {
+  if (!options_.enabled || !pairs_ || keyframe_id != keyframe_id_ ||
+      relative_baseline < options_.min_relative_baseline) {
+    return T_kf_frame;
+  }
+  const std::optional<TwoViewPair> pair = pairs_->TryFrame(frame);
+  if (!pair) return T_kf_frame;
+  // The pair gives the keyframe-to-frame pose; the frame centre in keyframe coordinates is
+  // -R^T t, the same quantity as T_kf_frame's translation.
+  const Eigen::Vector3d centre =
+      -(pair->T_frame_ref.Rotation().Inverse() * pair->T_frame_ref.Translation());
+  return SE3d(T_kf_frame.Rotation(),
+              BlendDirections(T_kf_frame.Translation(), centre, options_.essential_weight,
+                              options_.max_angle_deg));
+}
+
+}  // namespace parallax

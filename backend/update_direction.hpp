@@ -1,0 +1,73 @@
+#pragma once
+// A second, map-independent estimate of a tracked frame's translation direction for the depth
+// updates (docs/math/depth_filter.md, "Direction of the update pose").
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+
+#include "backend/two_view_bootstrap.hpp"
+#include "core/image.hpp"
+#include "core/pinhole_camera.hpp"
+#include "core/se3.hpp"
+
+namespace parallax {
+
+struct UpdateDirectionOptions {
+  bool enabled = true;
+  /// Only baselines of at least this share of the mean depth are checked (below, the
+  /// essential matrix's direction is poorly conditioned and tracking is left alone).
+  double min_relative_baseline = 0.03;
+  /// Share of the essential-matrix direction in the blend (0 = tracking only).
+  double essential_weight = 0.5;
+  /// The two directions must agree within this angle, degrees; otherwise tracking is kept.
+  /// Small corrections only: they stop the slow drift of the tracked direction, while the
+  /// essential matrix itself can be 5-10 degrees off on weak texture (docs/benchmarks.md has
+  /// the sensitivity: 2 degrees too few, 3-10 work on KITTI).
+  double max_angle_deg = 3.0;
+  /// ORB matching and essential-matrix RANSAC (a pair needs 0.5 degrees of parallax on 30
+  /// points and 100 inliers).
+  TwoViewBootstrapOptions matcher{
+      .min_inliers = 100, .min_parallax_deg = 0.5, .parallax_points = 30};
+
+  /// Throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+/// Blends two unit-free translation directions: weight w of `essential`, 1 - w of `tracked`
+/// (both normalised first), renormalised and given the length of `tracked`. Returns `tracked`
+/// when either is zero or they are more than max_angle_deg apart.
+Eigen::Vector3d BlendDirections(const Eigen::Vector3d& tracked, const Eigen::Vector3d& essential,
+                                double weight, double max_angle_deg);
+
+/// Direct tracking against a keyframe's depth map gets the translation direction from that
+/// map; an error in it is written into the map by the next depth update and biases the next
+/// tracking (a feedback that drifts the scale in fast forward motion). This keeps ORB features
+/// of the current keyframe and, for a frame with enough baseline, blends the tracked direction
+/// with the one of the essential matrix between keyframe and frame.
+class UpdateDirection {
+ public:
+  UpdateDirection(const PinholeCamera& camera, const UpdateDirectionOptions& options);
+  ~UpdateDirection();
+  UpdateDirection(UpdateDirection&&) noexcept;
+  UpdateDirection& operator=(UpdateDirection&&) noexcept;
+
+  /// The keyframe later frames are compared with (extracts its features).
+  void SetKeyframe(std::int64_t keyframe_id, const ImageU8& image);
+  /// Forgets the keyframe (e.g. tracking returned to an older one).
+  void Reset();
+
+  /// T_kf_frame with the blended translation direction (same length), or unchanged when the
+  /// keyframe is not the one set, the baseline is short, or no reliable pair is found.
+  /// `relative_baseline` = |t| x mean inverse depth of the keyframe.
+  SE3d Refine(std::int64_t keyframe_id, const ImageU8& frame, const SE3d& T_kf_frame,
+              double relative_baseline);
+
+ private:
+  UpdateDirectionOptions options_;
+  std::unique_ptr<TwoViewBootstrap> pairs_;
+  std::int64_t keyframe_id_ = -1;
+  PinholeCamera camera_;
+};
+
+}  // namespace parallax
