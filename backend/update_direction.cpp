@@ -41,8 +41,8 @@ UpdateDirection& UpdateDirection::operator=(UpdateDirection&&) noexcept = defaul
 
 void UpdateDirection::SetKeyframe(std::int64_t keyframe_id, const ImageU8& image) {
   if (!options_.enabled) return;
-  if (!pairs_) pairs_ = std::make_unique<TwoViewBootstrap>(camera_, options_.matcher);
-  pairs_->SetReference(image);
+  keyframe_image_ = image;
+  features_extracted_ = false;
   keyframe_id_ = keyframe_id;
 }
 
@@ -50,9 +50,14 @@ void UpdateDirection::Reset() { keyframe_id_ = -1; }
 
 SE3d UpdateDirection::Refine(std::int64_t keyframe_id, const ImageU8& frame, const SE3d& T_kf_frame,
                              double relative_baseline) {
-  if (!options_.enabled || !pairs_ || keyframe_id != keyframe_id_ ||
+  if (!options_.enabled || keyframe_id_ < 0 || keyframe_id != keyframe_id_ ||
       relative_baseline < options_.min_relative_baseline) {
     return T_kf_frame;
+  }
+  if (!pairs_) pairs_ = std::make_unique<TwoViewBootstrap>(camera_, options_.matcher);
+  if (!features_extracted_) {
+    pairs_->SetReference(keyframe_image_);
+    features_extracted_ = true;
   }
   const std::optional<TwoViewPair> pair = pairs_->TryFrame(frame);
   if (!pair) return T_kf_frame;

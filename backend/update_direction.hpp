@@ -53,7 +53,8 @@ class UpdateDirection {
   UpdateDirection(UpdateDirection&&) noexcept;
   UpdateDirection& operator=(UpdateDirection&&) noexcept;
 
-  /// The keyframe later frames are compared with (extracts its features).
+  /// The keyframe later frames are compared with (its features are extracted on the first
+  /// frame that needs them: many keyframes never see a long enough baseline).
   void SetKeyframe(std::int64_t keyframe_id, const ImageU8& image);
   /// Forgets the keyframe (e.g. tracking returned to an older one).
   void Reset();
@@ -68,6 +69,8 @@ class UpdateDirection {
   UpdateDirectionOptions options_;
   std::unique_ptr<TwoViewBootstrap> pairs_;
   std::int64_t keyframe_id_ = -1;
+  ImageU8 keyframe_image_;
+  bool features_extracted_ = false;
   PinholeCamera camera_;
 };
 

@@ -7,31 +7,14 @@
 #include <cmath>
 #include <numbers>
 
-#include "tests/tracking/render_fixture.hpp"
+#include "tests/backend/room_pair_fixture.hpp"
 
 namespace parallax {
 namespace {
 
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 
-class TwoViewBootstrapTest : public ::testing::Test {
- protected:
-  TwoViewBootstrapTest()
-      : scene_(synth::MakeScene("room", 1)),
-        camera_(synth::SynthCamera({})),
-        T_w_ref_(synth::FramePose({}, scene_, 0)) {}
-
-  ImageU8 RenderImage(const SE3d& T_w_c, float gain, double noise_sigma) const {
-    return test::RenderTestImage(scene_, T_w_c, gain, noise_sigma, 7);
-  }
-
-  /// Frame pose after moving by `T_ref_frame` (camera motion in the reference frame).
-  SE3d Moved(const SE3d& T_ref_frame) const { return T_w_ref_ * T_ref_frame; }
-
-  synth::Scene scene_;
-  PinholeCamera camera_;
-  SE3d T_w_ref_;
-};
+class TwoViewBootstrapTest : public test::RoomPairTest {};
 
 TEST_F(TwoViewBootstrapTest, RecoversRotationTranslationDirectionAndGain) {
   // 20 cm sideways and 5 cm forward with a 3 degree turn (a hand-held start after about a

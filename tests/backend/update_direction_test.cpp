@@ -8,7 +8,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "tests/tracking/render_fixture.hpp"
+#include "tests/backend/room_pair_fixture.hpp"
 
 namespace parallax {
 namespace {
@@ -49,20 +49,9 @@ TEST(UpdateDirectionOptions, RejectBadValues) {
   EXPECT_THROW(o.Check(), std::invalid_argument);
 }
 
-class UpdateDirectionTest : public ::testing::Test {
+class UpdateDirectionTest : public test::RoomPairTest {
  protected:
-  UpdateDirectionTest()
-      : scene_(synth::MakeScene("room", 1)),
-        camera_(synth::SynthCamera({})),
-        T_w_kf_(synth::FramePose({}, scene_, 0)) {}
-
-  ImageU8 Render(const SE3d& T_kf_c) const {
-    return test::RenderTestImage(scene_, T_w_kf_ * T_kf_c, 1.0f, 1.0, 7);
-  }
-
-  synth::Scene scene_;
-  PinholeCamera camera_;
-  SE3d T_w_kf_;
+  ImageU8 Render(const SE3d& T_kf_c) const { return RenderImage(Moved(T_kf_c), 1.0f, 1.0); }
 };
 
 // 20 cm sideways and 5 cm forward with a 2 degree turn in a room 2-4 m deep. The essential
