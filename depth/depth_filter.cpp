@@ -3,6 +3,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "core/check.hpp"
@@ -15,6 +16,8 @@ void Invalidate(InverseDepthMap* map, std::size_t i) {
   map->validity[i] = 0.0f;
   map->observations[i] = 0;
 }
+
+constexpr std::size_t Idx(int i) { return static_cast<std::size_t>(i); }
 
 void Add(DepthUpdateStats* total, const DepthUpdateStats& s) {
   total->attempted += s.attempted;
@@ -56,6 +59,7 @@ void DepthFilter::UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search
       break;
     case StereoStatus::kAmbiguous:
       ++stats->ambiguous;
+      if (!has_prior) --map->blacklist[i];  // LSD-SLAM's rule: two failed creations end the tries
       if (has_prior) {
         map->validity[i] -= options_.validity_gain;
         map->variance[i] *= options_.inconsistency_variance_factor;
@@ -68,6 +72,7 @@ void DepthFilter::UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search
       return;
     case StereoStatus::kNoMatch:
       ++stats->no_match;
+      if (!has_prior) --map->blacklist[i];
       return;
     case StereoStatus::kOutOfImage:
       ++stats->out_of_image;
@@ -127,6 +132,20 @@ DepthUpdateStats DepthFilter::Update(InverseDepthMap* map, const StereoFrame& fr
 
 void DepthFilter::Regularize(InverseDepthMap* map) const {
   const int w = map->Width(), h = map->Height();
+  // Inverse variances once per pixel (0 for invalid ones), and the distance decay as a table:
+  // the 5x5 loop below is then multiplications only.
+  std::vector<float> inv_var(map->valid.size(), 0.0f);
+  for (std::size_t i = 0; i < inv_var.size(); ++i) {
+    if (map->valid[i]) inv_var[i] = 1.0f / map->variance[i];
+  }
+  // Inverse variance, decaying mildly with distance (scale-free form of LSD's
+  // 1 / (var + dist^2 * REG_DIST_VAR)).
+  std::array<float, 25> decay{};
+  for (int dy = -2; dy <= 2; ++dy) {
+    for (int dx = -2; dx <= 2; ++dx)
+      decay[Idx((dy + 2) * 5 + dx + 2)] =
+          1.0f / (1.0f + 0.1f * static_cast<float>(dx * dx + dy * dy));
+  }
   std::vector<std::uint8_t> keep(map->valid.size(), 0);
   // Valid pixels are eligible ones, which keep a 3-pixel border: the 5x5 window needs no
   // bounds checks.
@@ -134,35 +153,43 @@ void DepthFilter::Regularize(InverseDepthMap* map) const {
     for (int x = 2; x < w - 2; ++x) {
       const std::size_t i = map->Index(x, y);
       if (!map->valid[i]) continue;
-      double sum_w = 0.0, sum_wd = 0.0, support = 0.0, agree = 0.0, disagree = 0.0;
-      for (int dy = -2; dy <= 2; ++dy) {
-        for (int dx = -2; dx <= 2; ++dx) {
-          const std::size_t j = map->Index(x + dx, y + dy);
-          if (!map->valid[j]) continue;
-          support += map->validity[j];
-          const float diff = map->idepth[j] - map->idepth[i];
-          const bool compatible = diff * diff <= map->variance[i] + map->variance[j];
-          // Observed neighbours vote on whether this estimate is an outlier.
-          if (j != i && map->observations[j] > 0)
-            (compatible ? agree : disagree) += map->validity[j];
-          if (!compatible) continue;
-          // Inverse variance, decaying mildly with distance (scale-free form of LSD's
-          // 1 / (var + dist^2 * REG_DIST_VAR)).
-          const double weight = 1.0 / (map->variance[j] * (1.0 + 0.1 * (dx * dx + dy * dy)));
-          sum_w += weight;
-          sum_wd += weight * map->idepth[j];
-        }
-      }
-      map->idepth_smoothed[i] = static_cast<float>(sum_wd / sum_w);
-      map->variance_smoothed[i] = std::min(map->variance[i], static_cast<float>(1.0 / sum_w));
-      // Removed: too little support around it, or observed neighbours mostly disagree (a
-      // wrong match that later observations within its own mu +- 2 sigma cannot correct).
-      keep[i] = support >= options_.min_neighbour_validity && !(disagree > agree);
+      RegularizePixel(map, inv_var, decay, x, y, &keep[i]);
     }
   });
   for (std::size_t i = 0; i < keep.size(); ++i) {
     if (map->valid[i] && !keep[i]) Invalidate(map, i);
   }
+}
+
+void DepthFilter::RegularizePixel(InverseDepthMap* map_ptr, const std::vector<float>& inv_var,
+                                  const std::array<float, 25>& decay, int x, int y,
+                                  std::uint8_t* keep) const {
+  InverseDepthMap& map = *map_ptr;
+  const std::size_t i = map.Index(x, y);
+  const float d_i = map.idepth[i], var_i = map.variance[i];
+  float sum_w = 0.0f, sum_wd = 0.0f, support = 0.0f, agree = 0.0f, disagree = 0.0f;
+  for (int dy = -2; dy <= 2; ++dy) {
+    const std::size_t row = map.Index(x - 2, y + dy);
+    const float* decay_row = &decay[Idx((dy + 2) * 5)];
+    for (int k = 0; k < 5; ++k) {
+      const std::size_t j = row + Idx(k);
+      if (!map.valid[j]) continue;
+      support += map.validity[j];
+      const float diff = map.idepth[j] - d_i;
+      const bool compatible = diff * diff <= var_i + map.variance[j];
+      // Observed neighbours vote on whether this estimate is an outlier.
+      if (j != i && map.observations[j] > 0) (compatible ? agree : disagree) += map.validity[j];
+      if (!compatible) continue;
+      const float weight = inv_var[j] * decay_row[k];
+      sum_w += weight;
+      sum_wd += weight * map.idepth[j];
+    }
+  }
+  map.idepth_smoothed[i] = sum_wd / sum_w;
+  map.variance_smoothed[i] = std::min(var_i, 1.0f / sum_w);
+  // Removed: too little support around it, or observed neighbours mostly disagree (a wrong
+  // match that later observations within its own mu +- 2 sigma cannot correct).
+  *keep = support >= options_.min_neighbour_validity && !(disagree > agree);
 }
 
 int DepthFilter::FillHoles(InverseDepthMap* map) const {

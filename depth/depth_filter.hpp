@@ -3,6 +3,10 @@
 // hole filling, propagation to a new keyframe and scale normalisation
 // (docs/math/depth_filter.md).
 
+#include <array>
+#include <cstdint>
+#include <vector>
+
 #include "core/frame.hpp"
 #include "core/se3.hpp"
 #include "depth/depth_map.hpp"
@@ -65,6 +69,9 @@ class DepthFilter {
  private:
   void UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search, int x, int y,
                    DepthUpdateStats* stats) const;
+  /// Smooths valid pixel (x, y) over its 5x5 neighbourhood; `keep` = 0 when it is an outlier.
+  void RegularizePixel(InverseDepthMap* map, const std::vector<float>& inv_var,
+                       const std::array<float, 25>& decay, int x, int y, std::uint8_t* keep) const;
   DepthFilterOptions options_;
 };
 

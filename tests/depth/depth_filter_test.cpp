@@ -124,6 +124,27 @@ TEST_F(DepthFilterTest, UpdateOfCorrectPriorReducesVarianceAndStaysWithinSigma) 
   EXPECT_LT(Summarize(map, keyframe_->idepth).median_relative, 0.02);
 }
 
+// LSD-SLAM's rule: a pixel whose full-range (creation) search fails twice, ambiguous or
+// without a match, is not searched again in this keyframe; the search is the update's most
+// expensive part and repeats the same failure on the same texture.
+TEST_F(DepthFilterTest, FailedCreationSearchesStopAfterTwo) {
+  DepthFilter filter;
+  InverseDepthMap map(keyframe_->frame, filter.Options());
+  const DepthUpdateStats first = filter.Update(&map, Stereo(8));
+  ASSERT_GT(first.ambiguous + first.no_match, 100);
+  filter.Update(&map, Stereo(8));
+  int given_up = 0, given_up_but_valid = 0;
+  for (std::size_t i = 0; i < map.valid.size(); ++i) {
+    if (map.blacklist[i] >= -1) continue;
+    ++given_up;
+    given_up_but_valid += map.valid[i];
+  }
+  EXPECT_GT(given_up, 50);
+  EXPECT_EQ(given_up_but_valid, 0);
+  const DepthUpdateStats third = filter.Update(&map, Stereo(8));
+  EXPECT_EQ(third.attempted, first.attempted - given_up);
+}
+
 TEST_F(DepthFilterTest, PropagationKeepsVisiblePoints) {
   DepthFilter filter;
   InverseDepthMap map(keyframe_->frame, filter.Options());
