@@ -29,4 +29,9 @@ Frame::Frame(std::int64_t id, double timestamp, const PinholeCamera& camera, con
   }
 }
 
+const ImageF& Frame::MaxGradient() const {
+  std::call_once(max_gradient_once_, [this] { max_gradient_ = MaxGradient3x3(Level(0)); });
+  return max_gradient_;
+}
+
 }  // namespace parallax

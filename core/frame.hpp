@@ -2,6 +2,7 @@
 // An input image prepared for tracking and mapping.
 
 #include <cstdint>
+#include <mutex>
 
 #include "core/image.hpp"
 #include "core/image_pyramid.hpp"
@@ -29,12 +30,18 @@ class Frame {
   const PinholeCamera& Camera(int level = 0) const {
     return cameras_[static_cast<std::size_t>(level)];
   }
+  /// MaxGradient3x3 of level 0 (grey levels / pixel), computed on the first call (keyframes
+  /// need it for pixel selection, every depth map and tracking reference built on them; other
+  /// frames never do) and thread-safe.
+  const ImageF& MaxGradient() const;
 
  private:
   std::int64_t id_;
   double timestamp_;
   ImagePyramid pyramid_;
   std::vector<PinholeCamera> cameras_;
+  mutable std::once_flag max_gradient_once_;
+  mutable ImageF max_gradient_;
 };
 
 }  // namespace parallax

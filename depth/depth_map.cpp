@@ -47,7 +47,7 @@ InverseDepthMap::InverseDepthMap(std::shared_ptr<const Frame> keyframe,
   valid.assign(n, 0);
   eligible.assign(n, 0);
   observations.assign(n, 0);
-  const ImageF max_gradient = MaxGradient3x3(keyframe_->Level(0));
+  const ImageF& max_gradient = keyframe_->MaxGradient();
   constexpr int kBorder = 3;  // the 5-sample pattern must stay inside the image
   for (int y = kBorder; y < height_ - kBorder; ++y) {
     for (int x = kBorder; x < width_ - kBorder; ++x) {

@@ -66,17 +66,25 @@ TrackingReference::TrackingReference(std::shared_ptr<const Frame> keyframe, cons
   CheckArgument(idepth.Width() == level0.Width() && idepth.Height() == level0.Height() &&
                     variance.Width() == level0.Width() && variance.Height() == level0.Height(),
                 "TrackingReference: idepth/variance images must have the keyframe's size");
-  const ImageF max_gradient = MaxGradient3x3(level0);
-  ReferenceLevel points;
-  double idepth_sum = 0.0;
+  const ImageF& max_gradient = keyframe_->MaxGradient();
   const int b = options.border;
+  const auto usable = [&](int x, int y) {
+    const float d = idepth(x, y), var = variance(x, y);
+    return d > 0.0f && var > 0.0f && std::isfinite(d) && std::isfinite(var) &&
+           max_gradient(x, y) >= options.min_gradient;
+  };
+  std::size_t count = 0;
+  for (int y = b; y < level0.Height() - b; ++y) {
+    for (int x = b; x < level0.Width() - b; ++x) count += usable(x, y);
+  }
+  ReferenceLevel points;
+  points.Reserve(count);
+  double idepth_sum = 0.0;
   for (int y = b; y < level0.Height() - b; ++y) {
     for (int x = b; x < level0.Width() - b; ++x) {
-      const float d = idepth(x, y), var = variance(x, y);
-      if (!(d > 0.0f) || !(var > 0.0f) || !std::isfinite(d) || !std::isfinite(var)) continue;
-      if (max_gradient(x, y) < options.min_gradient) continue;
-      AddPoint(&points, keyframe_->Camera(0), level0, x, y, d, var);
-      idepth_sum += d;
+      if (!usable(x, y)) continue;
+      AddPoint(&points, keyframe_->Camera(0), level0, x, y, idepth(x, y), variance(x, y));
+      idepth_sum += idepth(x, y);
     }
   }
   mean_idepth_ =

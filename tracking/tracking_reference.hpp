@@ -32,6 +32,10 @@ struct ReferenceLevel {
   std::vector<float> intensity;  ///< keyframe intensity at the pixel (this level)
 
   std::size_t Size() const { return u.size(); }
+  void Reserve(std::size_t n) {
+    for (std::vector<float>* field : {&u, &v, &ray_x, &ray_y, &idepth, &variance, &intensity})
+      field->reserve(n);
+  }
 };
 
 /// Semi-dense points of a keyframe for tracking. Level 0 takes every pixel with valid
