@@ -47,7 +47,8 @@ void System::RestoreStart(StartSnapshot snapshot) {
   depth_updates_ = snapshot.depth_updates;
 }
 
-double System::BufferedResidual() {
+double System::BufferedResidual(BufferedPoses* poses) {
+  poses->clear();
   if (initial_frames_.empty()) return 0.0;
   double sum = 0.0;
   AffineBrightness affine;  // carried along: exposure changes smoothly between frames
@@ -55,10 +56,12 @@ double System::BufferedResidual() {
     const TrackingResult r = tracker_.Track(*reference_, *frame, {T_kf_frame}, affine);
     if (r.status == TrackingStatus::kLost) {
       sum += kLostFrameResidual;
+      poses->emplace_back();
       continue;
     }
     affine = r.affine;
     sum += r.stats.residual_rms;
+    poses->emplace_back(r.T_kf_frame);
   }
   return sum / static_cast<double>(initial_frames_.size());
 }
@@ -79,22 +82,25 @@ void System::RefineWithBufferedFrames() {
   }
 }
 
-void System::KeepTheBetterStart(const std::shared_ptr<const Frame>& pair_frame,
-                                const TwoViewPair& pair) {
+System::BufferedPoses System::KeepTheBetterStart(const std::shared_ptr<const Frame>& pair_frame,
+                                                 const TwoViewPair& pair) {
   // A random start can converge to a smoothly distorted depth (on purely sideways motion,
   // with noise or exposure changes) that still tracks "ok" and agrees with the pair within
   // the geometric thresholds; the pair's depth, refined by the same frames, then explains
   // them with a clearly lower residual. Measured in docs/configuration.md.
-  const double random_residual = BufferedResidual();
+  BufferedPoses random_poses, pair_poses;
+  const double random_residual = BufferedResidual(&random_poses);
   StartSnapshot random_start = SaveStart();
   StartFromPair(pair_frame, pair);
   RefineWithBufferedFrames();
-  const double pair_residual = BufferedResidual();
+  const double pair_residual = BufferedResidual(&pair_poses);
   // Near-equal residuals are no evidence against the random start, whose depth has seen the
   // frames live: the pair must be clearly better.
   if (!(pair_residual < options_.auto_pair_residual_ratio * random_residual)) {
     RestoreStart(std::move(random_start));
+    return random_poses;
   }
+  return pair_poses;
 }
 
 }  // namespace parallax

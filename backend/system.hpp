@@ -144,15 +144,20 @@ class System {
   struct StartSnapshot;
   StartSnapshot SaveStart() const;
   void RestoreStart(StartSnapshot snapshot);
+  /// Poses of the buffered frames in the current keyframe (nullopt: lost), in buffer order.
+  using BufferedPoses = std::vector<std::optional<SE3d>>;
   /// Mean photometric residual (grey levels) of the buffered frames tracked against the
-  /// current map from their buffered poses; a lost frame counts as kLostFrameResidual.
-  double BufferedResidual();
+  /// current map from their buffered poses; a lost frame counts as kLostFrameResidual. The
+  /// tracked poses go to `poses`.
+  double BufferedResidual(BufferedPoses* poses);
   /// Tracks the buffered frames in order against the current map, updating its depth from
   /// each (as the random start did with its own poses).
   void RefineWithBufferedFrames();
   /// Builds the pair's start refined by the buffered frames and keeps whichever start has
-  /// the lower BufferedResidual.
-  void KeepTheBetterStart(const std::shared_ptr<const Frame>& pair_frame, const TwoViewPair& pair);
+  /// the lower BufferedResidual; returns the buffered frames' poses tracked against the kept
+  /// one (its scoring already tracked them all).
+  BufferedPoses KeepTheBetterStart(const std::shared_ptr<const Frame>& pair_frame,
+                                   const TwoViewPair& pair);
   FrameResult ProcessTwoViewOnly(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
   std::optional<FrameResult> ProcessWhileInitialising(const std::shared_ptr<const Frame>& frame,
                                                       const ImageU8& image,

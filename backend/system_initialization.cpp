@@ -76,6 +76,7 @@ std::optional<SE3d> System::TrackAgain(const Frame& frame, const SE3d& guess) {
 std::vector<RevisedPose> System::FinishInitialisation() {
   std::vector<RevisedPose> revised;
   bool replaced = false;
+  std::optional<BufferedPoses> poses;  // the buffered frames tracked against the final map
   if (pending_pair_) {
     // The converged random start must agree with the independent two-view geometry, and
     // then explain the frames at least as well as a start from the pair does.
@@ -90,15 +91,20 @@ std::vector<RevisedPose> System::FinishInitialisation() {
       replaced = true;
     } else {
       // Geometry agrees: the start whose depth explains the frames better is kept.
-      KeepTheBetterStart(pair_frame, pair);
+      poses = KeepTheBetterStart(pair_frame, pair);
     }
     pending_pair_.reset();
   }
   if (!replaced) {
-    for (const auto& [frame, T_kf_frame] : initial_frames_) {
-      const auto T_kf_again = TrackAgain(*frame, T_kf_frame);
-      RevisedPose pose{frame->Id(), frame->Timestamp(), std::nullopt};
-      if (T_kf_again) pose.T_w_c = (S_w_kf_ * Sim3d(*T_kf_again)).RigidPart();
+    if (!poses) {
+      poses.emplace();
+      for (const auto& [frame, T_kf_frame] : initial_frames_)
+        poses->push_back(TrackAgain(*frame, T_kf_frame));
+    }
+    for (std::size_t i = 0; i < initial_frames_.size(); ++i) {
+      const Frame& frame = *initial_frames_[i].first;
+      RevisedPose pose{frame.Id(), frame.Timestamp(), std::nullopt};
+      if ((*poses)[i]) pose.T_w_c = (S_w_kf_ * Sim3d(*(*poses)[i])).RigidPart();
       revised.push_back(pose);
     }
   }
