@@ -15,17 +15,35 @@ void UpdateDirectionOptions::Check() const {
               "must be in [0, 1]");
   CheckOption(max_angle_deg > 0.0 && max_angle_deg <= 180.0, s, "max_angle_deg",
               "must be in (0, 180]");
+  CheckOption(std::isfinite(recheck_growth), s, "recheck_growth", "must be finite");
+  CheckOption(reuse_max_angle_deg >= 0.0, s, "reuse_max_angle_deg", "must be >= 0");
   matcher.Check();
 }
+
+namespace {
+
+double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180.0 /
+         std::numbers::pi;
+}
+
+/// The smallest rotation taking direction a onto direction b (both non-zero).
+SO3d RotationBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const Eigen::Vector3d u = a.normalized(), v = b.normalized();
+  const Eigen::Vector3d axis = u.cross(v);
+  const double sin_angle = axis.norm();
+  if (sin_angle < 1e-12) return SO3d();
+  return SO3d::Exp(axis / sin_angle * std::atan2(sin_angle, u.dot(v)));
+}
+
+}  // namespace
 
 Eigen::Vector3d BlendDirections(const Eigen::Vector3d& tracked, const Eigen::Vector3d& essential,
                                 double weight, double max_angle_deg) {
   const double n_t = tracked.norm(), n_e = essential.norm();
   if (!(n_t > 0.0) || !(n_e > 0.0)) return tracked;
   const Eigen::Vector3d u_t = tracked / n_t, u_e = essential / n_e;
-  const double angle_deg =
-      std::acos(std::clamp(u_t.dot(u_e), -1.0, 1.0)) * 180.0 / std::numbers::pi;
-  if (angle_deg > max_angle_deg) return tracked;
+  if (AngleDeg(u_t, u_e) > max_angle_deg) return tracked;
   const Eigen::Vector3d blend = weight * u_e + (1.0 - weight) * u_t;
   return blend.normalized() * n_t;
 }
@@ -44,15 +62,26 @@ void UpdateDirection::SetKeyframe(std::int64_t keyframe_id, const ImageU8& image
   keyframe_image_ = image;
   features_extracted_ = false;
   keyframe_id_ = keyframe_id;
+  has_check_ = false;
 }
 
-void UpdateDirection::Reset() { keyframe_id_ = -1; }
+void UpdateDirection::Reset() {
+  keyframe_id_ = -1;
+  has_check_ = false;
+}
 
 SE3d UpdateDirection::Refine(std::int64_t keyframe_id, const ImageU8& frame, const SE3d& T_kf_frame,
                              double relative_baseline) {
   if (!options_.enabled || keyframe_id_ < 0 || keyframe_id != keyframe_id_ ||
       relative_baseline < options_.min_relative_baseline) {
     return T_kf_frame;
+  }
+  const Eigen::Vector3d& t = T_kf_frame.Translation();
+  if (has_check_ && options_.recheck_growth > 1.0 &&
+      relative_baseline < checked_baseline_ * options_.recheck_growth &&
+      relative_baseline * options_.recheck_growth > checked_baseline_ &&
+      AngleDeg(t, checked_direction_) <= options_.reuse_max_angle_deg) {
+    return SE3d(T_kf_frame.Rotation(), correction_ * t);
   }
   if (!pairs_) pairs_ = std::make_unique<TwoViewBootstrap>(camera_, options_.matcher);
   if (!features_extracted_) {
@@ -65,9 +94,13 @@ SE3d UpdateDirection::Refine(std::int64_t keyframe_id, const ImageU8& frame, con
   // -R^T t, the same quantity as T_kf_frame's translation.
   const Eigen::Vector3d centre =
       -(pair->T_frame_ref.Rotation().Inverse() * pair->T_frame_ref.Translation());
-  return SE3d(T_kf_frame.Rotation(),
-              BlendDirections(T_kf_frame.Translation(), centre, options_.essential_weight,
-                              options_.max_angle_deg));
+  const Eigen::Vector3d blended =
+      BlendDirections(t, centre, options_.essential_weight, options_.max_angle_deg);
+  has_check_ = true;
+  checked_direction_ = t;
+  checked_baseline_ = relative_baseline;
+  correction_ = RotationBetween(t, blended);
+  return SE3d(T_kf_frame.Rotation(), blended);
 }
 
 }  // namespace parallax

@@ -10,6 +10,7 @@
 #include "core/image.hpp"
 #include "core/pinhole_camera.hpp"
 #include "core/se3.hpp"
+#include "core/so3.hpp"
 
 namespace parallax {
 
@@ -28,6 +29,14 @@ struct UpdateDirectionOptions {
   /// ORB matching and essential-matrix RANSAC (800 features, half the bootstrap's: 15% faster
   /// end to end at the same accuracy; a pair needs 0.5 degrees of parallax on 30 points and 100
   /// inliers).
+  /// Between checks the last correction (the rotation taking the tracked direction onto the
+  /// blended one) is applied to later frames of the same keyframe while their tracked direction
+  /// stays within `reuse_max_angle_deg` of the checked one and their baseline within a factor
+  /// `recheck_growth` of the checked one; then the pair is matched again. The tracked
+  /// direction's error drifts slowly, so on steady motion this halves the checks' cost.
+  /// recheck_growth <= 1 checks every update.
+  double recheck_growth = 1.25;
+  double reuse_max_angle_deg = 5.0;
   TwoViewBootstrapOptions matcher{
       .max_features = 800, .min_inliers = 100, .min_parallax_deg = 0.5, .parallax_points = 30};
 
@@ -72,6 +81,12 @@ class UpdateDirection {
   ImageU8 keyframe_image_;
   bool features_extracted_ = false;
   PinholeCamera camera_;
+  // The last check on the current keyframe: its tracked direction and baseline, and the
+  // correction it found (identity when the directions disagreed).
+  bool has_check_ = false;
+  Eigen::Vector3d checked_direction_ = Eigen::Vector3d::Zero();
+  double checked_baseline_ = 0.0;
+  SO3d correction_;
 };
 
 }  // namespace parallax

@@ -77,7 +77,9 @@ TEST_F(UpdateDirectionTest, BlendsTheTrackedDirectionWithTheEssentialMatrix) {
                                        essential.normalized() * 0.21);
   };
 
-  UpdateDirection direction(camera_, {});
+  UpdateDirectionOptions every_update;
+  every_update.recheck_growth = 1.0;  // no reuse of a correction (tested below)
+  UpdateDirection direction(camera_, every_update);
   direction.SetKeyframe(3, keyframe);
   const SE3d T_tracked = tracked_at(2.0);
   const SE3d refined = direction.Refine(3, frame, T_tracked, 0.1);
@@ -94,6 +96,41 @@ TEST_F(UpdateDirectionTest, BlendsTheTrackedDirectionWithTheEssentialMatrix) {
   EXPECT_EQ(direction.Refine(3, frame, far_off, 0.1).Translation(), far_off.Translation());
   direction.Reset();
   EXPECT_EQ(direction.Refine(3, frame, T_tracked, 0.1).Translation(), t);
+}
+
+TEST_F(UpdateDirectionTest, ReusesTheLastCorrectionBetweenChecks) {
+  const SE3d T_true(SO3d(), Eigen::Vector3d(0.20, 0.0, 0.05));
+  const ImageU8 keyframe = Render(SE3d()), frame = Render(T_true);
+  TwoViewBootstrap matcher(camera_, UpdateDirectionOptions{}.matcher);
+  matcher.SetReference(keyframe);
+  const std::optional<TwoViewPair> pair = matcher.TryFrame(frame);
+  ASSERT_TRUE(pair.has_value());
+  const Eigen::Vector3d essential =
+      -(pair->T_frame_ref.Rotation().Inverse() * pair->T_frame_ref.Translation());
+  const auto tracked_at = [&](double deg) {
+    return SE3d(T_true.Rotation(), SO3d::Exp(Eigen::Vector3d(0.0, deg / kDegPerRad, 0.0)) *
+                                       essential.normalized() * 0.21);
+  };
+  UpdateDirection direction(camera_, {});  // recheck_growth 1.25, reuse within 5 degrees
+  direction.SetKeyframe(3, keyframe);
+  const SE3d checked = tracked_at(2.0);
+  EXPECT_NEAR(
+      AngleDeg(direction.Refine(3, frame, checked, 0.1).Translation(), checked.Translation()), 1.0,
+      0.01);  // a check: halfway to the essential matrix
+  // 1 degree further and a similar baseline: the same 1-degree correction, not a new check
+  // (which would blend halfway from 3 degrees, i.e. move it by 1.5).
+  const SE3d next = tracked_at(3.0);
+  const Eigen::Vector3d reused = direction.Refine(3, frame, next, 0.11).Translation();
+  EXPECT_NEAR(AngleDeg(reused, next.Translation()), 1.0, 0.01);
+  EXPECT_NEAR(AngleDeg(reused, essential), 2.0, 0.01);
+  EXPECT_NEAR(reused.norm(), 0.21, 1e-12);
+  // The baseline grew beyond 1.25x: checked again; 5 degrees is beyond the 3-degree gate.
+  const SE3d far_off = tracked_at(5.0);
+  EXPECT_EQ(direction.Refine(3, frame, far_off, 0.2).Translation(), far_off.Translation());
+  // The check left no correction; a direction 6 degrees from that one is checked again.
+  const SE3d back = tracked_at(-1.0);
+  EXPECT_NEAR(AngleDeg(direction.Refine(3, frame, back, 0.2).Translation(), back.Translation()),
+              0.5, 0.01);
 }
 
 TEST_F(UpdateDirectionTest, DisabledLeavesThePoseAlone) {
