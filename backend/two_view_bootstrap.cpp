@@ -6,7 +6,9 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/features2d.hpp>
+#include <opencv2/video/tracking.hpp>
 
+#include "backend/relative_pose_refinement.hpp"
 #include "core/check.hpp"
 
 namespace parallax {
@@ -142,6 +144,49 @@ double KthLargest(std::vector<double> values, int k) {
   return values[static_cast<std::size_t>(index)];
 }
 
+/// ORB positions are only as precise as the pyramid level a corner was found on (1.2^level
+/// pixels); a Lucas-Kanade step from each reference point, started at its ORB match, aligns
+/// the patches to a fraction of a pixel. Matches the step loses or moves by more than 2 pixels
+/// (not the same patch) are dropped.
+void RefineMatchesByKlt(const ImageU8& ref, const ImageU8& cur, Matches* matches) {
+  std::vector<cv::Point2f> ref_points, cur_points;
+  for (std::size_t i = 0; i < matches->ref.size(); ++i) {
+    ref_points.emplace_back(matches->ref[i]);
+    cur_points.emplace_back(matches->cur[i]);
+  }
+  const std::vector<cv::Point2f> orb_points = cur_points;
+  std::vector<std::uint8_t> status;
+  std::vector<float> error;
+  cv::calcOpticalFlowPyrLK(
+      Wrap(ref), Wrap(cur), ref_points, cur_points, status, error, cv::Size(11, 11), 1,
+      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.01),
+      cv::OPTFLOW_USE_INITIAL_FLOW);
+  Matches kept;
+  for (std::size_t i = 0; i < ref_points.size(); ++i) {
+    const cv::Point2f shift = cur_points[i] - orb_points[i];
+    if (!status[i] || shift.dot(shift) > 4.0f) continue;
+    kept.ref.push_back(matches->ref[i]);
+    kept.cur.emplace_back(cur_points[i]);
+  }
+  *matches = std::move(kept);
+}
+
+/// The RANSAC model is a 5-point solution; every cheirality-checked inlier refines it.
+RelativePose PolishOnInliers(const PinholeCamera& camera, const Matches& matches,
+                             const std::vector<std::size_t>& inliers, const RelativePose& pose) {
+  std::vector<Eigen::Vector2d> ref, cur;
+  ref.reserve(inliers.size());
+  cur.reserve(inliers.size());
+  const auto normalised = [&](const cv::Point2d& p) {
+    return Eigen::Vector2d((p.x - camera.Cx()) / camera.Fx(), (p.y - camera.Cy()) / camera.Fy());
+  };
+  for (const std::size_t i : inliers) {
+    ref.push_back(normalised(matches.ref[i]));
+    cur.push_back(normalised(matches.cur[i]));
+  }
+  return RefineRelativePose(ref, cur, pose, 0.5 * (camera.Fx() + camera.Fy()));
+}
+
 }  // namespace
 
 std::optional<TwoViewPair> TwoViewBootstrap::TryFrame(const ImageU8& image) {
@@ -151,8 +196,10 @@ std::optional<TwoViewPair> TwoViewBootstrap::TryFrame(const ImageU8& image) {
   cv::Mat descriptors;
   impl_->orb->detectAndCompute(Wrap(image), cv::noArray(), keypoints, descriptors);
   if (keypoints.size() < 50) return std::nullopt;
-  const Matches matches = MatchFeatures(impl_->ref_keypoints, impl_->ref_descriptors, keypoints,
-                                        descriptors, options.ratio_test);
+  Matches matches = MatchFeatures(impl_->ref_keypoints, impl_->ref_descriptors, keypoints,
+                                  descriptors, options.ratio_test);
+  if (static_cast<int>(matches.ref.size()) < options.min_inliers) return std::nullopt;
+  RefineMatchesByKlt(impl_->ref_image, image, &matches);
   if (static_cast<int>(matches.ref.size()) < options.min_inliers) return std::nullopt;
   cv::Mat K, inlier_mask, R, t, triangulated;
   cv::eigen2cv(impl_->camera.K(), K);
@@ -171,9 +218,11 @@ std::optional<TwoViewPair> TwoViewBootstrap::TryFrame(const ImageU8& image) {
   TwoViewPair pair;
   pair.parallax_deg = KthLargest(tri.angles_deg, options.parallax_points);
   if (pair.parallax_deg < options.min_parallax_deg) return std::nullopt;
+  const RelativePose refined =
+      PolishOnInliers(impl_->camera, matches, tri.match_index, {SO3d(R_e), t_e.normalized()});
   // |t| = 1 in recoverPose's units; scale so the median reference depth becomes 1.
   const double median_depth = KthLargest(tri.depths, static_cast<int>(tri.depths.size() / 2) + 1);
-  pair.T_frame_ref = SE3d(SO3d(R_e), t_e / median_depth);
+  pair.T_frame_ref = SE3d(refined.R_cur_ref, refined.t_cur_ref / median_depth);
   pair.inliers = static_cast<int>(tri.depths.size());
   std::vector<double> ref_means, cur_means;
   for (const std::size_t i : tri.match_index) {

@@ -69,9 +69,9 @@ TEST_F(UpdateDirectionTest, BlendsTheTrackedDirectionWithTheEssentialMatrix) {
   ASSERT_TRUE(pair.has_value());
   const Eigen::Vector3d essential =
       -(pair->T_frame_ref.Rotation().Inverse() * pair->T_frame_ref.Translation());
-  // Sanity only: on this weakly textured render the 800-feature matrix is ~12 degrees off (the
-  // 3 degree gate keeps such errors out); on KITTI it agrees with tracking within 1-6 degrees.
-  EXPECT_LT(AngleDeg(essential, T_true.Translation()), 15.0);
+  // Sanity only: on this weakly textured render the 800-feature direction is 5.4 degrees off
+  // (11.9 with ORB positions and the 5-point model alone; the gate keeps such errors out).
+  EXPECT_LT(AngleDeg(essential, T_true.Translation()), 8.0);
   const auto tracked_at = [&](double deg) {
     return SE3d(T_true.Rotation(), SO3d::Exp(Eigen::Vector3d(0.0, deg / kDegPerRad, 0.0)) *
                                        essential.normalized() * 0.21);
