@@ -19,6 +19,29 @@ void Invalidate(InverseDepthMap* map, std::size_t i) {
 
 constexpr std::size_t Idx(int i) { return static_cast<std::size_t>(i); }
 
+/// In place: each pixel becomes the sum of the 5x5 window around it (pixels within 2 of the
+/// border, whose window leaves the image, become 0; callers skip them).
+void BoxSum5x5(int w, int h, std::vector<float>* image) {
+  std::vector<float>& v = *image;
+  std::vector<float> rows(v.size(), 0.0f);
+  const auto at = [w](int x, int y) { return static_cast<std::size_t>(y) * Idx(w) + Idx(x); };
+  for (int y = 0; y < h; ++y) {
+    for (int x = 2; x < w - 2; ++x) {
+      const std::size_t i = at(x, y);
+      rows[i] = v[i - 2] + v[i - 1] + v[i] + v[i + 1] + v[i + 2];
+    }
+  }
+  std::fill(v.begin(), v.end(), 0.0f);
+  const std::size_t stride = Idx(w);
+  for (int y = 2; y < h - 2; ++y) {
+    for (int x = 2; x < w - 2; ++x) {
+      const std::size_t i = at(x, y);
+      v[i] = rows[i - 2 * stride] + rows[i - stride] + rows[i] + rows[i + stride] +
+             rows[i + 2 * stride];
+    }
+  }
+}
+
 void Add(DepthUpdateStats* total, const DepthUpdateStats& s) {
   total->attempted += s.attempted;
   total->created += s.created;
@@ -194,33 +217,31 @@ void DepthFilter::RegularizePixel(InverseDepthMap* map_ptr, const std::vector<fl
 
 int DepthFilter::FillHoles(InverseDepthMap* map) const {
   const int w = map->Width(), h = map->Height();
-  std::vector<std::uint8_t> fill(map->valid.size(), 0);
-  std::vector<float> value(map->valid.size(), 0.0f);
-  tbb::parallel_for(2, h - 2, [&](int y) {
+  const std::size_t n = map->valid.size();
+  // Sums over the valid pixels of each 5x5 window of validity, inverse variance and inverse
+  // depth / variance: box filters of the masked maps (separable, a few additions per pixel
+  // instead of 25 neighbour visits for each of the ~200k empty eligible pixels).
+  std::vector<float> support(n, 0.0f), sum_w(n, 0.0f), sum_wd(n, 0.0f);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!map->valid[i]) continue;
+    support[i] = map->validity[i];
+    sum_w[i] = 1.0f / map->variance[i];
+    sum_wd[i] = map->idepth[i] * sum_w[i];
+  }
+  for (std::vector<float>* image : {&support, &sum_w, &sum_wd}) BoxSum5x5(w, h, image);
+  std::vector<std::uint8_t> fill(n, 0);
+  int filled = 0;
+  for (int y = 2; y < h - 2; ++y) {
     for (int x = 2; x < w - 2; ++x) {
       const std::size_t i = map->Index(x, y);
       if (map->valid[i] || !map->eligible[i]) continue;
-      double support = 0.0, sum_w = 0.0, sum_wd = 0.0;
-      for (int dy = -2; dy <= 2; ++dy) {
-        for (int dx = -2; dx <= 2; ++dx) {
-          const std::size_t j = map->Index(x + dx, y + dy);
-          if (!map->valid[j]) continue;
-          support += map->validity[j];
-          sum_w += 1.0 / map->variance[j];
-          sum_wd += map->idepth[j] / map->variance[j];
-        }
-      }
-      const bool allowed = map->blacklist[i] >= -1 || support > 100.0;
-      if (support > options_.fill_validity && allowed) {
-        fill[i] = 1;
-        value[i] = static_cast<float>(sum_wd / sum_w);
-      }
+      const bool allowed = map->blacklist[i] >= -1 || support[i] > 100.0f;
+      fill[i] = support[i] > options_.fill_validity && allowed;
     }
-  });
-  int filled = 0;
-  for (std::size_t i = 0; i < fill.size(); ++i) {
+  }
+  for (std::size_t i = 0; i < n; ++i) {
     if (!fill[i]) continue;
-    const float d = value[i];
+    const float d = sum_wd[i] / sum_w[i];
     map->idepth[i] = map->idepth_smoothed[i] = d;
     map->variance[i] = map->variance_smoothed[i] = options_.initial_variance * d * d;
     map->validity[i] = options_.initial_validity;

@@ -145,6 +145,54 @@ TEST_F(DepthFilterTest, FailedCreationSearchesStopAfterTwo) {
   EXPECT_EQ(third.attempted, first.attempted - given_up);
 }
 
+// Hole filling: an empty eligible pixel whose 5x5 window has enough validity takes the
+// inverse-variance weighted mean of the valid pixels in it (checked against a direct sum).
+TEST_F(DepthFilterTest, FillHolesTakesTheWeightedMeanOfTheWindow) {
+  DepthFilter filter;
+  InverseDepthMap map(keyframe_->frame, filter.Options());
+  std::vector<std::size_t> eligible;
+  for (std::size_t i = 0; i < map.eligible.size(); ++i)
+    if (map.eligible[i]) eligible.push_back(i);
+  ASSERT_GT(eligible.size(), 10000u);
+  // Every third eligible pixel valid, with varied depth and variance.
+  for (std::size_t k = 0; k < eligible.size(); k += 3) {
+    const std::size_t i = eligible[k];
+    map.valid[i] = 1;
+    map.idepth[i] = 0.5f + 0.001f * static_cast<float>(k % 997);
+    map.variance[i] = 1e-4f * (1.0f + static_cast<float>(k % 7));
+    map.validity[i] = 10.0f + static_cast<float>(k % 5);
+  }
+  const InverseDepthMap before = map;
+  const int filled = filter.FillHoles(&map);
+  EXPECT_GT(filled, 1000);
+  int checked = 0, wrongly_filled = 0;
+  for (int y = 2; y < map.Height() - 2; ++y) {
+    for (int x = 2; x < map.Width() - 2; ++x) {
+      const std::size_t i = map.Index(x, y);
+      if (before.valid[i] || !before.eligible[i]) continue;
+      double support = 0.0, sum_w = 0.0, sum_wd = 0.0;
+      for (int dy = -2; dy <= 2; ++dy) {
+        for (int dx = -2; dx <= 2; ++dx) {
+          const std::size_t j = map.Index(x + dx, y + dy);
+          if (!before.valid[j]) continue;
+          support += before.validity[j];
+          sum_w += 1.0 / before.variance[j];
+          sum_wd += before.idepth[j] / before.variance[j];
+        }
+      }
+      if (support <= filter.Options().fill_validity) {
+        wrongly_filled += map.valid[i];
+        continue;
+      }
+      ASSERT_TRUE(map.valid[i]) << x << "," << y;
+      EXPECT_NEAR(map.idepth[i], sum_wd / sum_w, 1e-5);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, filled);
+  EXPECT_EQ(wrongly_filled, 0);
+}
+
 TEST_F(DepthFilterTest, PropagationKeepsVisiblePoints) {
   DepthFilter filter;
   InverseDepthMap map(keyframe_->frame, filter.Options());
