@@ -13,6 +13,7 @@
 
 #include "core/check.hpp"
 #include "core/undistorter.hpp"
+#include "tools/dataset/frame_prefetcher.hpp"
 #include "tools/dataset/input_error.hpp"
 #include "tools/dataset/trajectory.hpp"
 
@@ -69,13 +70,13 @@ RunSummary RunDataset(const RunOptions& options) {
   std::vector<std::optional<StampedPose>> poses;  // by frame index; revisions overwrite
   std::vector<double> tracking_ms, mapping_ms;
   RunSummary summary;
-  ImageU8 rectified;
   const auto start = std::chrono::steady_clock::now();
+  const std::size_t num_frames = reader->NumFrames();  // the reader belongs to `frames` now
+  FramePrefetcher frames(reader.get(), &undistorter);
   while (options.max_frames == 0 || summary.frames < options.max_frames) {
-    const auto frame = reader->Next();
+    const auto frame = frames.Next();
     if (!frame) break;
-    undistorter.Apply(frame->image, &rectified);
-    const FrameResult result = system.ProcessFrame(rectified, frame->timestamp);
+    const FrameResult result = system.ProcessFrame(frame->image, frame->timestamp);
     ++summary.frames;
     summary.frames_tracked += result.T_w_c.has_value();
     poses.emplace_back();
@@ -89,7 +90,7 @@ RunSummary RunDataset(const RunOptions& options) {
     mapping_ms.push_back(result.mapping_ms);
     if (options.progress) {
       std::fprintf(stderr, "\rframe %d/%zu  tracked %d  keyframes %zu  %s   ", summary.frames,
-                   reader->NumFrames(), summary.frames_tracked, system.Keyframes().size(),
+                   num_frames, summary.frames_tracked, system.Keyframes().size(),
                    ToString(result.status).c_str());
     }
   }
