@@ -17,6 +17,8 @@ void UpdateDirectionOptions::Check() const {
               "must be in (0, 180]");
   CheckOption(std::isfinite(recheck_growth), s, "recheck_growth", "must be finite");
   CheckOption(reuse_max_angle_deg >= 0.0, s, "reuse_max_angle_deg", "must be >= 0");
+  CheckOption(max_axis_angle_deg >= 0.0 && max_axis_angle_deg <= 90.0, s, "max_axis_angle_deg",
+              "must be in [0, 90]");
   matcher.Check();
 }
 
@@ -77,6 +79,9 @@ SE3d UpdateDirection::Refine(std::int64_t keyframe_id, const ImageU8& frame, con
     return T_kf_frame;
   }
   const Eigen::Vector3d& t = T_kf_frame.Translation();
+  if (AngleDeg(t.cwiseAbs(), Eigen::Vector3d::UnitZ()) > options_.max_axis_angle_deg) {
+    return T_kf_frame;
+  }
   if (has_check_ && options_.recheck_growth > 1.0 &&
       relative_baseline < checked_baseline_ * options_.recheck_growth &&
       relative_baseline * options_.recheck_growth > checked_baseline_ &&

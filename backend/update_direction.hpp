@@ -29,6 +29,11 @@ struct UpdateDirectionOptions {
   /// ORB matching and essential-matrix RANSAC (800 features, half the bootstrap's: 15% faster
   /// end to end at the same accuracy; a pair needs 0.5 degrees of parallax on 30 points and 100
   /// inliers).
+  /// Only translations within this angle of the optical axis (forward or backward) are
+  /// checked: the direction drift was measured on forward motion (KITTI, walks), while on
+  /// sideways motion (orbits, hand-held) the check changed nothing beyond noise and cost 10-15
+  /// ms per frame (docs/math/depth_filter.md).
+  double max_axis_angle_deg = 45.0;
   /// Between checks the last correction (the rotation taking the tracked direction onto the
   /// blended one) is applied to later frames of the same keyframe while their tracked direction
   /// stays within `reuse_max_angle_deg` of the checked one and their baseline within a factor

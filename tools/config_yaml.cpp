@@ -83,6 +83,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"update_direction_max_angle_deg", Set(&o->update_direction.max_angle_deg)},
         {"update_direction_min_baseline", Set(&o->update_direction.min_relative_baseline)},
         {"update_direction_recheck_growth", Set(&o->update_direction.recheck_growth)},
+        {"update_direction_max_axis_angle_deg", Set(&o->update_direction.max_axis_angle_deg)},
         {"update_direction_reuse_max_angle_deg", Set(&o->update_direction.reuse_max_angle_deg)}}},
   };
 }

@@ -78,7 +78,8 @@ TEST_F(UpdateDirectionTest, BlendsTheTrackedDirectionWithTheEssentialMatrix) {
   };
 
   UpdateDirectionOptions every_update;
-  every_update.recheck_growth = 1.0;  // no reuse of a correction (tested below)
+  every_update.recheck_growth = 1.0;       // no reuse of a correction (tested below)
+  every_update.max_axis_angle_deg = 90.0;  // this step is mostly sideways (tested below)
   UpdateDirection direction(camera_, every_update);
   direction.SetKeyframe(3, keyframe);
   const SE3d T_tracked = tracked_at(2.0);
@@ -111,7 +112,9 @@ TEST_F(UpdateDirectionTest, ReusesTheLastCorrectionBetweenChecks) {
     return SE3d(T_true.Rotation(), SO3d::Exp(Eigen::Vector3d(0.0, deg / kDegPerRad, 0.0)) *
                                        essential.normalized() * 0.21);
   };
-  UpdateDirection direction(camera_, {});  // recheck_growth 1.25, reuse within 5 degrees
+  UpdateDirectionOptions options;  // recheck_growth 1.25, reuse within 5 degrees
+  options.max_axis_angle_deg = 90.0;
+  UpdateDirection direction(camera_, options);
   direction.SetKeyframe(3, keyframe);
   const SE3d checked = tracked_at(2.0);
   EXPECT_NEAR(
@@ -131,6 +134,22 @@ TEST_F(UpdateDirectionTest, ReusesTheLastCorrectionBetweenChecks) {
   const SE3d back = tracked_at(-1.0);
   EXPECT_NEAR(AngleDeg(direction.Refine(3, frame, back, 0.2).Translation(), back.Translation()),
               0.5, 0.01);
+}
+
+TEST_F(UpdateDirectionTest, SidewaysMotionIsNotChecked) {
+  // 20 cm sideways, 5 cm forward: 76 degrees from the optical axis, beyond the default 45.
+  // The same pair is blended once the limit is lifted, so only the limit leaves it alone.
+  const SE3d T(SO3d(), Eigen::Vector3d(0.20, 0.0, 0.05));
+  const ImageU8 keyframe = Render(SE3d()), frame = Render(T);
+  const SE3d tracked(SO3d(), SO3d::Exp(Eigen::Vector3d(0.0, 0.02, 0.0)) * T.Translation());
+  UpdateDirection by_default(camera_, {});
+  by_default.SetKeyframe(3, keyframe);
+  EXPECT_EQ(by_default.Refine(3, frame, tracked, 0.1).Translation(), tracked.Translation());
+  UpdateDirectionOptions any_direction;
+  any_direction.max_axis_angle_deg = 90.0;
+  UpdateDirection lifted(camera_, any_direction);
+  lifted.SetKeyframe(3, keyframe);
+  EXPECT_NE(lifted.Refine(3, frame, tracked, 0.1).Translation(), tracked.Translation());
 }
 
 TEST_F(UpdateDirectionTest, DisabledLeavesThePoseAlone) {
