@@ -73,8 +73,10 @@ struct SystemOptions {
   int min_frames_per_keyframe = 3;
   /// The random start counts as initialised after this many depth updates of the first
   /// keyframe; the frames tracked before that are then tracked again against the converged
-  /// depth and their poses revised (design.md section 3a).
-  int initialization_updates = 30;
+  /// depth and their poses revised (design.md section 3a). 20 (two thirds of a second at 30
+  /// frames/s; 30 before) makes the start's one-off comparison a third cheaper: 90-frame
+  /// renders 9-13% faster end to end, TUM 5.6 -> 5.9 mm, renders unchanged within noise.
+  int initialization_updates = 20;
   /// At most this many frames are kept for re-tracking before initialisation completes (a
   /// static start would otherwise keep them all); older ones keep their first pose.
   int max_buffered_frames = 60;
