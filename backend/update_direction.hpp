@@ -40,7 +40,7 @@ struct UpdateDirectionOptions {
   /// `recheck_growth` of the checked one; then the pair is matched again. The tracked
   /// direction's error drifts slowly, so on steady motion this halves the checks' cost.
   /// recheck_growth <= 1 checks every update.
-  double recheck_growth = 1.25;
+  double recheck_growth = 1.5;
   double reuse_max_angle_deg = 5.0;
   TwoViewBootstrapOptions matcher{
       .max_features = 800, .min_inliers = 100, .min_parallax_deg = 0.5, .parallax_points = 30};

@@ -112,7 +112,7 @@ TEST_F(UpdateDirectionTest, ReusesTheLastCorrectionBetweenChecks) {
     return SE3d(T_true.Rotation(), SO3d::Exp(Eigen::Vector3d(0.0, deg / kDegPerRad, 0.0)) *
                                        essential.normalized() * 0.21);
   };
-  UpdateDirectionOptions options;  // recheck_growth 1.25, reuse within 5 degrees
+  UpdateDirectionOptions options;  // recheck_growth 1.5, reuse within 5 degrees
   options.max_axis_angle_deg = 90.0;
   UpdateDirection direction(camera_, options);
   direction.SetKeyframe(3, keyframe);
@@ -127,7 +127,7 @@ TEST_F(UpdateDirectionTest, ReusesTheLastCorrectionBetweenChecks) {
   EXPECT_NEAR(AngleDeg(reused, next.Translation()), 1.0, 0.01);
   EXPECT_NEAR(AngleDeg(reused, essential), 2.0, 0.01);
   EXPECT_NEAR(reused.norm(), 0.21, 1e-12);
-  // The baseline grew beyond 1.25x: checked again; 5 degrees is beyond the 3-degree gate.
+  // The baseline grew beyond 1.5x: checked again; 5 degrees is beyond the 3-degree gate.
   const SE3d far_off = tracked_at(5.0);
   EXPECT_EQ(direction.Refine(3, frame, far_off, 0.2).Translation(), far_off.Translation());
   // The check left no correction; a direction 6 degrees from that one is checked again.
