@@ -20,6 +20,22 @@ TEST(Frame, BuildsPyramidAndLevelCameras) {
   }
 }
 
+TEST(Frame, MaxGradientIsComputedOnceAndMatchesTheFilter) {
+  const PinholeCamera camera(64, 48, 50, 50, 31.5, 23.5);
+  ImageU8 image(64, 48, 0);
+  for (int y = 0; y < 48; ++y) {
+    for (int x = 0; x < 64; ++x) image(x, y) = static_cast<std::uint8_t>((x * 7 + y * y) % 251);
+  }
+  const Frame frame(0, 0.0, camera, image);
+  const ImageF& first = frame.MaxGradient();
+  const ImageF expected = MaxGradient3x3(frame.Level(0));
+  ASSERT_EQ(first.Width(), expected.Width());
+  ASSERT_EQ(first.Height(), expected.Height());
+  for (std::size_t i = 0; i < expected.NumPixels(); ++i)
+    ASSERT_EQ(first.Data()[i], expected.Data()[i]) << i;
+  EXPECT_EQ(&frame.MaxGradient(), &first);  // cached, not recomputed
+}
+
 TEST(Frame, RejectsMismatchedOrEmptyInput) {
   const PinholeCamera camera(640, 480, 500, 500, 319.5, 239.5);
   EXPECT_THROW(Frame(0, 0.0, camera, ImageU8(320, 240)), std::invalid_argument);
