@@ -1,22 +1,11 @@
 // System: the start of a sequence (design.md section 3a, docs/configuration.md).
 
 #include <cmath>
-#include <numbers>
 
 #include "backend/system.hpp"
+#include "core/angles.hpp"
 
 namespace parallax {
-namespace {
-
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
-
-double AngleBetweenDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  const double norms = a.norm() * b.norm();
-  if (norms <= 0.0) return 180.0;
-  return std::acos(std::clamp(a.dot(b) / norms, -1.0, 1.0)) * kRadToDeg;
-}
-
-}  // namespace
 
 FrameResult System::StartFirstKeyframe(const std::shared_ptr<const Frame>& frame,
                                        const ImageU8& image) {

@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/video/tracking.hpp>
 
 #include "backend/relative_pose_refinement.hpp"
+#include "core/angles.hpp"
 #include "core/check.hpp"
 
 namespace parallax {
@@ -89,8 +89,6 @@ void TwoViewBootstrap::SetReference(const ImageU8& image) {
 
 namespace {
 
-constexpr double kDegPerRad = 180.0 / std::numbers::pi;
-
 struct Matches {
   std::vector<cv::Point2d> ref, cur;
 };
@@ -128,8 +126,7 @@ Triangulation CollectInliers(const cv::Mat& triangulated, const cv::Mat& inlier_
     const Eigen::Vector3d X(triangulated.at<double>(0, i) / w, triangulated.at<double>(1, i) / w,
                             triangulated.at<double>(2, i) / w);
     if (X.z() <= 0.0) continue;
-    const Eigen::Vector3d a = X.normalized(), b = (X - centre_cur_in_ref).normalized();
-    out.angles_deg.push_back(std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * kDegPerRad);
+    out.angles_deg.push_back(AngleBetweenDeg(X, X - centre_cur_in_ref));
     out.depths.push_back(X.z());
     out.match_index.push_back(static_cast<std::size_t>(i));
   }

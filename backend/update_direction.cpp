@@ -1,9 +1,8 @@
 #include "backend/update_direction.hpp"
 
-#include <algorithm>
 #include <cmath>
-#include <numbers>
 
+#include "core/angles.hpp"
 #include "core/check.hpp"
 
 namespace parallax {
@@ -22,30 +21,12 @@ void UpdateDirectionOptions::Check() const {
   matcher.Check();
 }
 
-namespace {
-
-double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180.0 /
-         std::numbers::pi;
-}
-
-/// The smallest rotation taking direction a onto direction b (both non-zero).
-SO3d RotationBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  const Eigen::Vector3d u = a.normalized(), v = b.normalized();
-  const Eigen::Vector3d axis = u.cross(v);
-  const double sin_angle = axis.norm();
-  if (sin_angle < 1e-12) return SO3d();
-  return SO3d::Exp(axis / sin_angle * std::atan2(sin_angle, u.dot(v)));
-}
-
-}  // namespace
-
 Eigen::Vector3d BlendDirections(const Eigen::Vector3d& tracked, const Eigen::Vector3d& essential,
                                 double weight, double max_angle_deg) {
   const double n_t = tracked.norm(), n_e = essential.norm();
   if (!(n_t > 0.0) || !(n_e > 0.0)) return tracked;
   const Eigen::Vector3d u_t = tracked / n_t, u_e = essential / n_e;
-  if (AngleDeg(u_t, u_e) > max_angle_deg) return tracked;
+  if (AngleBetweenDeg(u_t, u_e) > max_angle_deg) return tracked;
   const Eigen::Vector3d blend = weight * u_e + (1.0 - weight) * u_t;
   return blend.normalized() * n_t;
 }
@@ -79,13 +60,13 @@ SE3d UpdateDirection::Refine(std::int64_t keyframe_id, const ImageU8& frame, con
     return T_kf_frame;
   }
   const Eigen::Vector3d& t = T_kf_frame.Translation();
-  if (AngleDeg(t.cwiseAbs(), Eigen::Vector3d::UnitZ()) > options_.max_axis_angle_deg) {
+  if (AngleBetweenDeg(t.cwiseAbs(), Eigen::Vector3d::UnitZ()) > options_.max_axis_angle_deg) {
     return T_kf_frame;
   }
   if (has_check_ && options_.recheck_growth > 1.0 &&
       relative_baseline < checked_baseline_ * options_.recheck_growth &&
       relative_baseline * options_.recheck_growth > checked_baseline_ &&
-      AngleDeg(t, checked_direction_) <= options_.reuse_max_angle_deg) {
+      AngleBetweenDeg(t, checked_direction_) <= options_.reuse_max_angle_deg) {
     return SE3d(T_kf_frame.Rotation(), correction_ * t);
   }
   if (!pairs_) pairs_ = std::make_unique<TwoViewBootstrap>(camera_, options_.matcher);
@@ -104,7 +85,7 @@ SE3d UpdateDirection::Refine(std::int64_t keyframe_id, const ImageU8& frame, con
   has_check_ = true;
   checked_direction_ = t;
   checked_baseline_ = relative_baseline;
-  correction_ = RotationBetween(t, blended);
+  correction_ = SO3d(Eigen::Quaterniond::FromTwoVectors(t, blended));
   return SE3d(T_kf_frame.Rotation(), blended);
 }
 

@@ -229,25 +229,23 @@ int DepthFilter::FillHoles(InverseDepthMap* map) const {
     sum_wd[i] = map->idepth[i] * sum_w[i];
   }
   for (std::vector<float>* image : {&support, &sum_w, &sum_wd}) BoxSum5x5(w, h, image);
-  std::vector<std::uint8_t> fill(n, 0);
+  // The window sums were taken before any filling, so filling a pixel here changes no other
+  // pixel's decision.
   int filled = 0;
   for (int y = 2; y < h - 2; ++y) {
     for (int x = 2; x < w - 2; ++x) {
       const std::size_t i = map->Index(x, y);
       if (map->valid[i] || !map->eligible[i]) continue;
       const bool allowed = map->blacklist[i] >= -1 || support[i] > 100.0f;
-      fill[i] = support[i] > options_.fill_validity && allowed;
+      if (!(support[i] > options_.fill_validity && allowed)) continue;
+      const float d = sum_wd[i] / sum_w[i];
+      map->idepth[i] = map->idepth_smoothed[i] = d;
+      map->variance[i] = map->variance_smoothed[i] = options_.initial_variance * d * d;
+      map->validity[i] = options_.initial_validity;
+      map->observations[i] = 0;
+      map->valid[i] = 1;
+      ++filled;
     }
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!fill[i]) continue;
-    const float d = sum_wd[i] / sum_w[i];
-    map->idepth[i] = map->idepth_smoothed[i] = d;
-    map->variance[i] = map->variance_smoothed[i] = options_.initial_variance * d * d;
-    map->validity[i] = options_.initial_validity;
-    map->observations[i] = 0;
-    map->valid[i] = 1;
-    ++filled;
   }
   return filled;
 }

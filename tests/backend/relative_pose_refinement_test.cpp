@@ -5,18 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <numbers>
 #include <random>
+
+#include "core/angles.hpp"
 
 namespace parallax {
 namespace {
 
-constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 constexpr double kFocal = 500.0;
-
-double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * kDegPerRad;
-}
 
 struct Correspondences {
   std::vector<Eigen::Vector2d> ref, cur;
@@ -65,11 +61,11 @@ TEST(RefineRelativePose, ConvergesFromAPerturbedPoseToTheTruth) {
   const Correspondences c = Make(truth, 300, 0.5, 2);
   RelativePose start;
   start.R_cur_ref =
-      SO3d::Exp(Eigen::Vector3d(0.0, 2.0 / kDegPerRad, 1.0 / kDegPerRad)) * truth.R_cur_ref;
-  start.t_cur_ref = (SO3d::Exp(Eigen::Vector3d(0.0, 0.0, 8.0 / kDegPerRad)) * truth.t_cur_ref);
+      SO3d::Exp(Eigen::Vector3d(0.0, 2.0 / kRadToDeg, 1.0 / kRadToDeg)) * truth.R_cur_ref;
+  start.t_cur_ref = (SO3d::Exp(Eigen::Vector3d(0.0, 0.0, 8.0 / kRadToDeg)) * truth.t_cur_ref);
   const RelativePose refined = RefineRelativePose(c.ref, c.cur, start, kFocal);
-  EXPECT_LT((refined.R_cur_ref.Inverse() * truth.R_cur_ref).Log().norm() * kDegPerRad, 0.1);
-  EXPECT_LT(AngleDeg(refined.t_cur_ref, truth.t_cur_ref), 0.5);
+  EXPECT_LT((refined.R_cur_ref.Inverse() * truth.R_cur_ref).Log().norm() * kRadToDeg, 0.1);
+  EXPECT_LT(AngleBetweenDeg(refined.t_cur_ref, truth.t_cur_ref), 0.5);
   EXPECT_NEAR(refined.t_cur_ref.norm(), 1.0, 1e-12);
 }
 
@@ -84,8 +80,8 @@ TEST(RefineRelativePose, OutliersPullLessThanInLeastSquares) {
   RelativePoseRefinementOptions least_squares;
   least_squares.huber_px = 1e6;
   const double robust =
-      AngleDeg(RefineRelativePose(c.ref, c.cur, truth, kFocal).t_cur_ref, truth.t_cur_ref);
-  const double plain = AngleDeg(
+      AngleBetweenDeg(RefineRelativePose(c.ref, c.cur, truth, kFocal).t_cur_ref, truth.t_cur_ref);
+  const double plain = AngleBetweenDeg(
       RefineRelativePose(c.ref, c.cur, truth, kFocal, least_squares).t_cur_ref, truth.t_cur_ref);
   RecordProperty("robust_deg", std::to_string(robust));
   RecordProperty("least_squares_deg", std::to_string(plain));

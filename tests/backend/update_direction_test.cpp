@@ -5,28 +5,23 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
-#include <numbers>
+#include <optional>
 
+#include "core/angles.hpp"
 #include "tests/backend/room_pair_fixture.hpp"
 
 namespace parallax {
 namespace {
 
-constexpr double kDegPerRad = 180.0 / std::numbers::pi;
-
-double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * kDegPerRad;
-}
-
 TEST(BlendDirections, HalfwayWithTheTrackedLength) {
   const Eigen::Vector3d tracked(0.0, 0.0, 2.0), essential(0.1, 0.0, 1.0);  // 5.7 deg apart
   const Eigen::Vector3d b = BlendDirections(tracked, essential, 0.5, 10.0);
   EXPECT_NEAR(b.norm(), 2.0, 1e-12);
-  EXPECT_NEAR(AngleDeg(b, tracked), AngleDeg(b, essential), 1e-9);
-  EXPECT_NEAR(AngleDeg(b, tracked), 0.5 * AngleDeg(tracked, essential), 1e-9);
+  EXPECT_NEAR(AngleBetweenDeg(b, tracked), AngleBetweenDeg(b, essential), 1e-9);
+  EXPECT_NEAR(AngleBetweenDeg(b, tracked), 0.5 * AngleBetweenDeg(tracked, essential), 1e-9);
   EXPECT_EQ(BlendDirections(tracked, essential, 0.0, 10.0), tracked);
-  EXPECT_NEAR(AngleDeg(BlendDirections(tracked, essential, 1.0, 10.0), essential), 0.0, 1e-6);
+  EXPECT_NEAR(AngleBetweenDeg(BlendDirections(tracked, essential, 1.0, 10.0), essential), 0.0,
+              1e-6);
 }
 
 TEST(BlendDirections, KeepsTrackingWhenTheyDisagreeOrOneIsZero) {
@@ -52,6 +47,22 @@ TEST(UpdateDirectionOptions, RejectBadValues) {
 class UpdateDirectionTest : public test::RoomPairTest {
  protected:
   ImageU8 Render(const SE3d& T_kf_c) const { return RenderImage(Moved(T_kf_c), 1.0f, 1.0); }
+  /// The essential matrix's translation direction keyframe -> frame (the frame centre in
+  /// keyframe coordinates), found with the check's own matcher; nullopt without a pair.
+  std::optional<Eigen::Vector3d> EssentialDirection(const ImageU8& keyframe,
+                                                    const ImageU8& frame) const {
+    TwoViewBootstrap matcher(camera_, UpdateDirectionOptions{}.matcher);
+    matcher.SetReference(keyframe);
+    const std::optional<TwoViewPair> pair = matcher.TryFrame(frame);
+    if (!pair) return std::nullopt;
+    return -(pair->T_frame_ref.Rotation().Inverse() * pair->T_frame_ref.Translation());
+  }
+  /// A tracked pose: the true rotation, and a 0.21 long translation turned `deg` degrees about
+  /// the y axis from `direction`.
+  static SE3d TrackedAt(const SE3d& T_true, const Eigen::Vector3d& direction, double deg) {
+    return SE3d(T_true.Rotation(), SO3d::Exp(Eigen::Vector3d(0.0, deg / kRadToDeg, 0.0)) *
+                                       direction.normalized() * 0.21);
+  }
 };
 
 // 20 cm sideways and 5 cm forward with a 2 degree turn in a room 2-4 m deep. The essential
@@ -60,22 +71,16 @@ class UpdateDirectionTest : public test::RoomPairTest {
 // tracked rotation and length, and be left alone for a short baseline, another keyframe, or a
 // tracked direction beyond the 3 degree gate.
 TEST_F(UpdateDirectionTest, BlendsTheTrackedDirectionWithTheEssentialMatrix) {
-  const SE3d T_true(SO3d::Exp(Eigen::Vector3d(0.0, 2.0 / kDegPerRad, 0.0)),
+  const SE3d T_true(SO3d::Exp(Eigen::Vector3d(0.0, 2.0 / kRadToDeg, 0.0)),
                     Eigen::Vector3d(0.20, 0.0, 0.05));
   const ImageU8 keyframe = Render(SE3d()), frame = Render(T_true);
-  TwoViewBootstrap matcher(camera_, UpdateDirectionOptions{}.matcher);
-  matcher.SetReference(keyframe);
-  const std::optional<TwoViewPair> pair = matcher.TryFrame(frame);
-  ASSERT_TRUE(pair.has_value());
-  const Eigen::Vector3d essential =
-      -(pair->T_frame_ref.Rotation().Inverse() * pair->T_frame_ref.Translation());
+  const std::optional<Eigen::Vector3d> found = EssentialDirection(keyframe, frame);
+  ASSERT_TRUE(found.has_value());
+  const Eigen::Vector3d essential = *found;
   // Sanity only: on this weakly textured render the 800-feature direction is 5.4 degrees off
   // (11.9 with ORB positions and the 5-point model alone; the gate keeps such errors out).
-  EXPECT_LT(AngleDeg(essential, T_true.Translation()), 8.0);
-  const auto tracked_at = [&](double deg) {
-    return SE3d(T_true.Rotation(), SO3d::Exp(Eigen::Vector3d(0.0, deg / kDegPerRad, 0.0)) *
-                                       essential.normalized() * 0.21);
-  };
+  EXPECT_LT(AngleBetweenDeg(essential, T_true.Translation()), 8.0);
+  const auto tracked_at = [&](double deg) { return TrackedAt(T_true, essential, deg); };
 
   UpdateDirectionOptions every_update;
   every_update.recheck_growth = 1.0;       // no reuse of a correction (tested below)
@@ -84,8 +89,8 @@ TEST_F(UpdateDirectionTest, BlendsTheTrackedDirectionWithTheEssentialMatrix) {
   direction.SetKeyframe(3, keyframe);
   const SE3d T_tracked = tracked_at(2.0);
   const SE3d refined = direction.Refine(3, frame, T_tracked, 0.1);
-  EXPECT_NEAR(AngleDeg(refined.Translation(), essential), 1.0, 0.01);
-  EXPECT_NEAR(AngleDeg(refined.Translation(), T_tracked.Translation()), 1.0, 0.01);
+  EXPECT_NEAR(AngleBetweenDeg(refined.Translation(), essential), 1.0, 0.01);
+  EXPECT_NEAR(AngleBetweenDeg(refined.Translation(), T_tracked.Translation()), 1.0, 0.01);
   EXPECT_NEAR(refined.Translation().norm(), 0.21, 1e-12);
   EXPECT_EQ(refined.Rotation().UnitQuaternion().coeffs(),
             T_tracked.Rotation().UnitQuaternion().coeffs());
@@ -102,38 +107,34 @@ TEST_F(UpdateDirectionTest, BlendsTheTrackedDirectionWithTheEssentialMatrix) {
 TEST_F(UpdateDirectionTest, ReusesTheLastCorrectionBetweenChecks) {
   const SE3d T_true(SO3d(), Eigen::Vector3d(0.20, 0.0, 0.05));
   const ImageU8 keyframe = Render(SE3d()), frame = Render(T_true);
-  TwoViewBootstrap matcher(camera_, UpdateDirectionOptions{}.matcher);
-  matcher.SetReference(keyframe);
-  const std::optional<TwoViewPair> pair = matcher.TryFrame(frame);
-  ASSERT_TRUE(pair.has_value());
-  const Eigen::Vector3d essential =
-      -(pair->T_frame_ref.Rotation().Inverse() * pair->T_frame_ref.Translation());
-  const auto tracked_at = [&](double deg) {
-    return SE3d(T_true.Rotation(), SO3d::Exp(Eigen::Vector3d(0.0, deg / kDegPerRad, 0.0)) *
-                                       essential.normalized() * 0.21);
-  };
+  const std::optional<Eigen::Vector3d> found = EssentialDirection(keyframe, frame);
+  ASSERT_TRUE(found.has_value());
+  const Eigen::Vector3d essential = *found;
+  const auto tracked_at = [&](double deg) { return TrackedAt(T_true, essential, deg); };
   UpdateDirectionOptions options;  // recheck_growth 1.5, reuse within 5 degrees
   options.max_axis_angle_deg = 90.0;
   UpdateDirection direction(camera_, options);
   direction.SetKeyframe(3, keyframe);
   const SE3d checked = tracked_at(2.0);
-  EXPECT_NEAR(
-      AngleDeg(direction.Refine(3, frame, checked, 0.1).Translation(), checked.Translation()), 1.0,
-      0.01);  // a check: halfway to the essential matrix
+  EXPECT_NEAR(AngleBetweenDeg(direction.Refine(3, frame, checked, 0.1).Translation(),
+                              checked.Translation()),
+              1.0,
+              0.01);  // a check: halfway to the essential matrix
   // 1 degree further and a similar baseline: the same 1-degree correction, not a new check
   // (which would blend halfway from 3 degrees, i.e. move it by 1.5).
   const SE3d next = tracked_at(3.0);
   const Eigen::Vector3d reused = direction.Refine(3, frame, next, 0.11).Translation();
-  EXPECT_NEAR(AngleDeg(reused, next.Translation()), 1.0, 0.01);
-  EXPECT_NEAR(AngleDeg(reused, essential), 2.0, 0.01);
+  EXPECT_NEAR(AngleBetweenDeg(reused, next.Translation()), 1.0, 0.01);
+  EXPECT_NEAR(AngleBetweenDeg(reused, essential), 2.0, 0.01);
   EXPECT_NEAR(reused.norm(), 0.21, 1e-12);
   // The baseline grew beyond 1.5x: checked again; 5 degrees is beyond the 3-degree gate.
   const SE3d far_off = tracked_at(5.0);
   EXPECT_EQ(direction.Refine(3, frame, far_off, 0.2).Translation(), far_off.Translation());
   // The check left no correction; a direction 6 degrees from that one is checked again.
   const SE3d back = tracked_at(-1.0);
-  EXPECT_NEAR(AngleDeg(direction.Refine(3, frame, back, 0.2).Translation(), back.Translation()),
-              0.5, 0.01);
+  EXPECT_NEAR(
+      AngleBetweenDeg(direction.Refine(3, frame, back, 0.2).Translation(), back.Translation()), 0.5,
+      0.01);
 }
 
 TEST_F(UpdateDirectionTest, SidewaysMotionIsNotChecked) {
