@@ -16,6 +16,7 @@ int Run(int argc, char** argv) {
   parallax::cli::AddDemoCommand(app, &exit_code);
   parallax::cli::AddEvalCommand(app, &exit_code);
   parallax::cli::AddInfoCommand(app, &exit_code);
+  parallax::cli::AddPosegraphCommand(app, &exit_code);
   parallax::cli::AddRunCommand(app, &exit_code);
   parallax::cli::AddSynthCommand(app, &exit_code);
   try {
