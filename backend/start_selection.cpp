@@ -15,7 +15,7 @@ constexpr double kLostFrameResidual = 100.0;
 /// Everything the start has built that trying another start would overwrite.
 struct System::StartSnapshot {
   std::unique_ptr<InverseDepthMap> map;
-  std::unique_ptr<TrackingReference> reference;
+  std::shared_ptr<const TrackingReference> reference;  // immutable: shared, not copied
   std::vector<std::pair<std::shared_ptr<const Frame>, SE3d>> frames;
   AffineBrightness affine;
   SE3d T_kf_last, T_prev_last;
@@ -26,7 +26,7 @@ struct System::StartSnapshot {
 System::StartSnapshot System::SaveStart() const {
   StartSnapshot s;
   s.map = std::make_unique<InverseDepthMap>(*map_);
-  s.reference = std::make_unique<TrackingReference>(*reference_);
+  s.reference = reference_;
   s.frames = initial_frames_;
   s.affine = affine_;
   s.T_kf_last = T_kf_last_;

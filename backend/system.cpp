@@ -14,20 +14,6 @@ double MillisecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-std::vector<Eigen::Vector3f> WorldPoints(const InverseDepthMap& map, const Sim3d& S_w_kf) {
-  std::vector<Eigen::Vector3f> points;
-  const PinholeCamera& K = map.Keyframe().Camera(0);
-  for (int y = 0; y < map.Height(); ++y) {
-    for (int x = 0; x < map.Width(); ++x) {
-      const std::size_t i = map.Index(x, y);
-      if (!map.IsConfirmed(i)) continue;
-      const Eigen::Vector3d p = K.Unproject(Eigen::Vector2d(x, y)) / map.idepth_smoothed[i];
-      points.push_back((S_w_kf * p).cast<float>());
-    }
-  }
-  return points;
-}
-
 }  // namespace
 
 void SystemOptions::Check() const {
@@ -37,6 +23,7 @@ void SystemOptions::Check() const {
   depth.Check();
   update_direction.Check();
   bootstrap.Check();
+  backend.Check();
   CheckOption(bootstrap_max_frames >= 1, "SystemOptions", "bootstrap_max_frames", "must be >= 1");
   CheckOption(auto_max_rotation_deg > 0.0, "SystemOptions", "auto_max_rotation_deg", "must be > 0");
   CheckOption(auto_max_direction_deg > 0.0, "SystemOptions", "auto_max_direction_deg",
@@ -63,38 +50,138 @@ System::System(const PinholeCamera& camera, const SystemOptions& options)
       options_(options),
       tracker_(options.tracker),
       depth_filter_(options.depth),
-      update_direction_(camera, options.update_direction) {
+      update_direction_(camera, options.update_direction),
+      backend_(options.backend) {
   options_.Check();
 }
 
 void System::RebuildReference() {
   ImageF idepth, variance;
   map_->ExportSmoothed(&idepth, &variance);
-  reference_ = std::make_unique<TrackingReference>(map_->KeyframePtr(), idepth, variance,
-                                                   options_.reference);
+  reference_ = std::make_shared<const TrackingReference>(map_->KeyframePtr(), idepth, variance,
+                                                         options_.reference);
+}
+
+Sim3d System::KeyframePose(std::int64_t id) const {
+  if (id == current_.id) return CurrentKeyframePose();
+  return graph_.Pose(id);
+}
+
+Sim3d System::CurrentKeyframePose() const {
+  if (graph_.Contains(current_.id)) return graph_.Pose(current_.id);
+  if (current_.parent) return graph_.Pose(*current_.parent) * current_.S_parent_kf;
+  return current_.S_parent_kf;
+}
+
+void System::SetPose(FrameResult* result, const SE3d& T_kf_frame) const {
+  result->anchor = AnchoredPose{current_.id, T_kf_frame};
+  result->T_w_c = (CurrentKeyframePose() * Sim3d(T_kf_frame)).RigidPart();
+}
+
+RevisedPose System::Revised(const Frame& frame, const std::optional<SE3d>& T_kf_frame) const {
+  RevisedPose pose;
+  pose.frame_id = frame.Id();
+  pose.timestamp = frame.Timestamp();
+  if (T_kf_frame) {
+    pose.keyframe_id = current_.id;
+    pose.T_kf_frame = *T_kf_frame;
+    pose.T_w_c = (CurrentKeyframePose() * Sim3d(*T_kf_frame)).RigidPart();
+  }
+  return pose;
+}
+
+void System::FinishCurrentKeyframe(FrameResult* result) {
+  auto keyframe = std::make_shared<Keyframe>();
+  keyframe->id = map_->KeyframePtr()->Id();
+  keyframe->timestamp = map_->KeyframePtr()->Timestamp();
+  keyframe->frame = map_->KeyframePtr();
+  keyframe->depth = FrozenDepth::FromMap(*map_);
+  keyframe->reference = reference_;
+  const bool is_new = !graph_.Contains(keyframe->id);
+  graph_.Upsert(keyframe, CurrentKeyframePose());
+  result->events.push_back({SystemEvent::Kind::kKeyframeFinished, result_frame_id_, keyframe->id});
+  if (!options_.optimize_graph) {
+    if (is_new && current_.parent) {
+      graph_.AddEdge(PoseGraphEdge{*current_.parent, keyframe->id, current_.S_parent_kf,
+                                   Matrix7d::Identity(), EdgeKind::kOdometry});
+    }
+    return;
+  }
+  const auto start = Clock::now();
+  const BackendReport report = backend_.KeyframeFinished(
+      &graph_, keyframe->id, is_new ? current_.parent : std::nullopt, current_.S_parent_kf);
+  backend_stats_.alignments += report.alignments;
+  backend_stats_.edges_rejected += report.edges_rejected;
+  if (report.optimisation) {
+    ++backend_stats_.optimisations;
+    backend_stats_.iterations += report.optimisation->iterations;
+    backend_stats_.optimisation_ms.push_back(MillisecondsSince(start));
+    result->events.push_back({SystemEvent::Kind::kGraphOptimised, result_frame_id_, keyframe->id});
+  }
 }
 
 void System::StartKeyframe(const std::shared_ptr<const Frame>& frame, const Sim3d& S_w_kf,
-                           InverseDepthMap map) {
+                           InverseDepthMap map, FrameResult* result) {
+  CurrentKeyframe next{frame->Id(), std::nullopt, S_w_kf};
   if (map_) {
-    finished_points_[map_->KeyframePtr()->Id()] = WorldPoints(*map_, S_w_kf_);
+    // Relative to the keyframe it grew from, before the backend moves that one.
+    next.parent = current_.id;
+    next.S_parent_kf = CurrentKeyframePose().Inverse() * S_w_kf;
+    FinishCurrentKeyframe(result);
     if (options_.recent_keyframes > 0) {
-      recent_.push_front({std::move(map_), std::move(reference_), S_w_kf_});
+      recent_.push_front({std::move(map_), std::move(reference_)});
       if (static_cast<int>(recent_.size()) > options_.recent_keyframes) recent_.pop_back();
     }
   }
+  current_ = next;
   map_ = std::make_unique<InverseDepthMap>(std::move(map));
-  S_w_kf_ = S_w_kf;
-  keyframes_.push_back({frame->Id(), frame->Timestamp(), S_w_kf});
   T_kf_last_ = SE3d();
   T_prev_last_ = SE3d();
   frames_in_keyframe_ = 0;
   RebuildReference();
+  result->events.push_back({SystemEvent::Kind::kKeyframeCreated, frame->Id(), frame->Id()});
+}
+
+void System::Record(std::int64_t frame_id, const FrameResult& result) {
+  const auto index = static_cast<std::size_t>(frame_id);
+  frame_poses_.resize(std::max(frame_poses_.size(), index + 1));
+  frame_poses_[index] = result.anchor;
+  for (const RevisedPose& r : result.revised) {
+    auto& pose = frame_poses_[static_cast<std::size_t>(r.frame_id)];
+    pose.reset();
+    if (r.T_w_c) pose = AnchoredPose{r.keyframe_id, r.T_kf_frame};
+  }
+}
+
+void System::ClearMap() {
+  graph_.Clear();
+  recent_.clear();
+  map_.reset();
+  reference_.reset();
+  current_ = CurrentKeyframe{};
 }
 
 FrameResult System::ProcessFrame(const ImageU8& image, double timestamp) {
+  CheckArgument(std::isfinite(timestamp), "System::ProcessFrame: timestamp is not finite");
+  CheckArgument(image.Width() == camera_.Width() && image.Height() == camera_.Height(),
+                "System::ProcessFrame: image is " + std::to_string(image.Width()) + "x" +
+                    std::to_string(image.Height()) + ", the camera " +
+                    std::to_string(camera_.Width()) + "x" + std::to_string(camera_.Height()));
   auto frame =
-      std::make_shared<const Frame>(frame_count_++, timestamp, camera_, image, options_.pyramid);
+      std::make_shared<const Frame>(frame_count_, timestamp, camera_, image, options_.pyramid);
+  ++frame_count_;
+  frame_timestamps_.push_back(timestamp);
+  result_frame_id_ = frame->Id();
+  FrameResult result = Process(frame, image);
+  if (!result.T_w_c) result.events.push_back({SystemEvent::Kind::kLost, frame->Id(), -1});
+  if (!result.revised.empty()) {
+    result.events.push_back({SystemEvent::Kind::kPosesRevised, frame->Id(), -1});
+  }
+  Record(frame->Id(), result);
+  return result;
+}
+
+FrameResult System::Process(const std::shared_ptr<const Frame>& frame, const ImageU8& image) {
   if (!map_) return StartFirstKeyframe(frame, image);
   if (options_.initialization == Initialization::kTwoView && bootstrap_) {
     return ProcessTwoViewOnly(frame, image);
@@ -102,12 +189,13 @@ FrameResult System::ProcessFrame(const ImageU8& image, double timestamp) {
   FrameResult result;
   TrackingResult tracked = TrackFrame(*frame, &result);
   if (tracked.status == TrackingStatus::kLost && initialised_at_frame_ >= 0) {
-    if (auto recovered = TrackRecentKeyframes(*frame)) {
+    if (auto recovered = TrackRecentKeyframes(*frame, &result)) {
       tracked = std::move(*recovered);
       result.status = tracked.status;
       result.stats = tracked.stats;
       result.stats.reason = "recovered on a recent keyframe";
-      result.T_w_c = (S_w_kf_ * Sim3d(tracked.T_kf_frame)).RigidPart();
+      SetPose(&result, tracked.T_kf_frame);
+      result.events.push_back({SystemEvent::Kind::kRecovered, frame->Id(), current_.id});
     }
   }
   if (initialised_at_frame_ < 0) {
@@ -129,7 +217,7 @@ TrackingResult System::TrackFrame(const Frame& frame, FrameResult* result) {
   T_kf_last_ = tracked.T_kf_frame;
   affine_ = tracked.affine;
   ++frames_in_keyframe_;
-  result->T_w_c = (S_w_kf_ * Sim3d(tracked.T_kf_frame)).RigidPart();
+  SetPose(result, tracked.T_kf_frame);
   return tracked;
 }
 
@@ -172,9 +260,11 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& 
     const float s = depth_filter_.NormalizeScale(&next);
     // Normalising multiplies idepth by s, so a point's new-keyframe coordinates become
     // p' = p / s; the keyframe-to-world similarity absorbs it: S_w_new = S_w_c * Sim3(s).
-    const Sim3d S_w_c = S_w_kf_ * Sim3d(tracked.T_kf_frame);
+    const Sim3d S_w_c = CurrentKeyframePose() * Sim3d(tracked.T_kf_frame);
     const SE3d velocity(T_prev_last_.Rotation(), T_prev_last_.Translation() / s);
-    StartKeyframe(frame, S_w_c * Sim3d(s, SO3d(), Eigen::Vector3d::Zero()), std::move(next));
+    StartKeyframe(frame, S_w_c * Sim3d(s, SO3d(), Eigen::Vector3d::Zero()), std::move(next),
+                  result);
+    SetPose(result, SE3d());  // the frame is the new keyframe
     update_direction_.SetKeyframe(frame->Id(), image);
     T_prev_last_ = velocity;  // constant-velocity guess for the next frame, new keyframe units
     affine_ = AffineBrightness{};
@@ -183,26 +273,29 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& 
   result->mapping_ms = MillisecondsSince(start);
 }
 
-std::optional<TrackingResult> System::TrackRecentKeyframes(const Frame& frame) {
-  const Sim3d S_w_last = S_w_kf_ * Sim3d(T_kf_last_);
+std::optional<TrackingResult> System::TrackRecentKeyframes(const Frame& frame,
+                                                           FrameResult* result) {
+  const Sim3d S_w_last = CurrentKeyframePose() * Sim3d(T_kf_last_);
   for (auto it = recent_.begin(); it != recent_.end(); ++it) {
     // Two starts, each tracked on its own (the tracker would prefer a start that sees few
     // points with small residuals): the last pose carried over through the similarities,
     // and the keyframe's own pose (the camera came back to where it was taken).
-    TrackingResult r = tracker_.Track(
-        *it->reference, frame, {(it->S_w_kf.Inverse() * S_w_last).RigidPart()}, AffineBrightness{});
+    const std::int64_t id = it->map->KeyframePtr()->Id();
+    TrackingResult r =
+        tracker_.Track(*it->reference, frame, {(graph_.Pose(id).Inverse() * S_w_last).RigidPart()},
+                       AffineBrightness{});
     if (r.status != TrackingStatus::kOk) {
       r = tracker_.Track(*it->reference, frame, {SE3d()}, AffineBrightness{});
     }
     if (r.status != TrackingStatus::kOk) continue;
-    // The found keyframe becomes current again; the current one takes its place among the
-    // recent ones (its points are finished; the found one's are live again).
-    finished_points_[map_->KeyframePtr()->Id()] = WorldPoints(*map_, S_w_kf_);
-    finished_points_.erase(it->map->KeyframePtr()->Id());
+    // The found keyframe becomes current again (its depth is refined further and frozen
+    // again when it is left); the current one is finished and takes its place among the
+    // recent ones.
+    FinishCurrentKeyframe(result);
     std::swap(map_, it->map);
     std::swap(reference_, it->reference);
-    std::swap(S_w_kf_, it->S_w_kf);
     std::rotate(recent_.begin(), it, std::next(it));
+    current_ = CurrentKeyframe{id, std::nullopt, Sim3d()};
     update_direction_.Reset();  // its features are of the keyframe left behind
     T_kf_last_ = r.T_kf_frame;
     T_prev_last_ = SE3d();
@@ -214,14 +307,46 @@ std::optional<TrackingResult> System::TrackRecentKeyframes(const Frame& frame) {
 }
 
 std::vector<Eigen::Vector3f> System::MapPoints() const {
-  std::vector<Eigen::Vector3f> all;
-  for (const auto& [id, points] : finished_points_)
-    all.insert(all.end(), points.begin(), points.end());
-  if (map_) {
-    const auto current = WorldPoints(*map_, S_w_kf_);
-    all.insert(all.end(), current.begin(), current.end());
+  std::vector<Eigen::Vector3f> all = graph_.MapPoints();
+  if (map_ && !graph_.Contains(current_.id)) {
+    // The current keyframe's confirmed points, through its current pose.
+    const Sim3d S_w_kf = CurrentKeyframePose();
+    const PinholeCamera& K = map_->Keyframe().Camera(0);
+    for (int y = 0; y < map_->Height(); ++y) {
+      for (int x = 0; x < map_->Width(); ++x) {
+        const std::size_t i = map_->Index(x, y);
+        if (!map_->IsConfirmed(i)) continue;
+        const Eigen::Vector3d p = K.Unproject(Eigen::Vector2d(x, y)) / map_->idepth_smoothed[i];
+        all.push_back((S_w_kf * p).cast<float>());
+      }
+    }
   }
   return all;
+}
+
+std::vector<KeyframeRecord> System::Keyframes() const {
+  std::vector<KeyframeRecord> records;
+  for (const std::int64_t id : graph_.Ids()) {
+    records.push_back({id, graph_.Get(id).timestamp, graph_.Pose(id)});
+  }
+  if (map_ && !graph_.Contains(current_.id)) {
+    records.push_back({current_.id, map_->KeyframePtr()->Timestamp(), CurrentKeyframePose()});
+  }
+  return records;
+}
+
+std::vector<FramePose> System::Trajectory() const {
+  std::vector<FramePose> poses;
+  for (std::size_t k = 0; k < frame_poses_.size(); ++k) {
+    const auto& anchor = frame_poses_[k];
+    // A frame anchored to a keyframe of a map discarded by a restart has no pose any more.
+    if (!anchor || (anchor->keyframe_id != current_.id && !graph_.Contains(anchor->keyframe_id)))
+      continue;
+    const Sim3d S_w_kf = KeyframePose(anchor->keyframe_id);
+    poses.push_back({static_cast<std::int64_t>(k), frame_timestamps_[k],
+                     (S_w_kf * Sim3d(anchor->T_kf_frame)).RigidPart()});
+  }
+  return poses;
 }
 
 }  // namespace parallax

@@ -8,6 +8,8 @@
 #include <optional>
 #include <vector>
 
+#include "backend/graph_backend.hpp"
+#include "backend/keyframe_graph.hpp"
 #include "backend/two_view_bootstrap.hpp"
 #include "backend/update_direction.hpp"
 #include "core/frame.hpp"
@@ -80,6 +82,10 @@ struct SystemOptions {
   /// At most this many frames are kept for re-tracking before initialisation completes (a
   /// static start would otherwise keep them all); older ones keep their first pose.
   int max_buffered_frames = 60;
+  /// Constraint search and pose-graph optimisation when a keyframe is finished; false keeps
+  /// the tracking chain as it is (odometry edges only, never optimised).
+  bool optimize_graph = true;
+  GraphBackendOptions backend;
 
   void Check() const;
 };
@@ -90,19 +96,63 @@ struct RevisedPose {
   std::int64_t frame_id = 0;
   double timestamp = 0.0;
   std::optional<SE3d> T_w_c;
+  std::int64_t keyframe_id = -1;  ///< with T_kf_frame: the pose as the map stores it
+  SE3d T_kf_frame;
+};
+
+/// Something that happened while processing a frame, for the CLI and the C API.
+struct SystemEvent {
+  enum class Kind {
+    kKeyframeCreated,   ///< keyframe_id: the new current keyframe
+    kKeyframeFinished,  ///< keyframe_id: frozen into the graph, constraints searched
+    kGraphOptimised,    ///< every keyframe pose (and so every frame and point) may have moved
+    kLost,              ///< the frame got no pose
+    kRecovered,         ///< tracked again on a recent keyframe (keyframe_id)
+    kPosesRevised,      ///< earlier frames' poses revised or withdrawn (initialisation)
+    kRestarted,         ///< the start failed and began again at this frame
+  };
+  Kind kind = Kind::kLost;
+  std::int64_t frame_id = 0;
+  std::int64_t keyframe_id = -1;
+};
+
+/// A frame's pose as the map holds it: relative to a keyframe, so that a correction of the
+/// keyframe graph moves the frame with it.
+struct AnchoredPose {
+  std::int64_t keyframe_id = 0;
+  SE3d T_kf_frame;
+};
+
+/// A frame's world pose computed from the map (camera-to-world, first keyframe's world).
+struct FramePose {
+  std::int64_t frame_id = 0;
+  double timestamp = 0.0;
+  SE3d T_w_c;
+};
+
+/// Keyframe-graph figures for stats.json.
+struct BackendStats {
+  int optimisations = 0;
+  int iterations = 0;
+  int alignments = 0;
+  int edges_rejected = 0;
+  std::vector<double> optimisation_ms;
 };
 
 /// Per-frame outcome.
 struct FrameResult {
   TrackingStatus status = TrackingStatus::kLost;
-  /// Camera-to-world pose (world = first keyframe, its scale); empty when lost.
+  /// Camera-to-world pose (world = first keyframe, its scale) as estimated now; empty when
+  /// lost. The map keeps it as `anchor`, which later graph corrections move.
   std::optional<SE3d> T_w_c;
+  std::optional<AnchoredPose> anchor;
   bool is_keyframe = false;
   TrackingStats stats;
   double tracking_ms = 0.0;  ///< wall time of tracking this frame
   double mapping_ms = 0.0;   ///< depth update and keyframe creation
   /// Earlier frames re-tracked (or withdrawn) when initialisation completed or restarted.
   std::vector<RevisedPose> revised;
+  std::vector<SystemEvent> events;
 };
 
 /// A finished or current keyframe as the outputs need it.
@@ -119,23 +169,40 @@ class System {
   /// `camera` is the ideal pinhole camera of the (already undistorted) images.
   explicit System(const PinholeCamera& camera, const SystemOptions& options = {});
 
-  /// Processes one undistorted 8-bit image. Throws std::invalid_argument for a wrong size.
+  /// Processes one undistorted 8-bit image. Throws std::invalid_argument for a wrong size,
+  /// before anything changes.
   FrameResult ProcessFrame(const ImageU8& image, double timestamp);
 
-  const std::vector<KeyframeRecord>& Keyframes() const { return keyframes_; }
-  /// Semi-dense points of all keyframes (world coordinates), confirmed estimates only.
+  /// Every keyframe (finished ones through the optimised graph, then the current one).
+  std::vector<KeyframeRecord> Keyframes() const;
+  /// Semi-dense points of all keyframes (world coordinates), confirmed estimates only,
+  /// through the keyframes' current (optimised) poses.
   std::vector<Eigen::Vector3f> MapPoints() const;
+  /// Every frame that has a pose, in frame order, through its keyframe's current pose.
+  std::vector<FramePose> Trajectory() const;
+  const KeyframeGraph& Graph() const { return graph_; }
+  const BackendStats& Backend() const { return backend_stats_; }
   int FramesProcessed() const { return frame_count_; }
   /// Index of the frame at which initialisation completed; -1 while initialising.
   int InitialisedAtFrame() const { return initialised_at_frame_; }
 
  private:
+  FrameResult Process(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
   void StartKeyframe(const std::shared_ptr<const Frame>& frame, const Sim3d& S_w_kf,
-                     InverseDepthMap map);
+                     InverseDepthMap map, FrameResult* result);
+  /// Freezes the current keyframe into the graph and runs the backend on it.
+  void FinishCurrentKeyframe(FrameResult* result);
+  /// Keyframe-to-world pose of the current keyframe (through its parent while unfinished).
+  Sim3d CurrentKeyframePose() const;
+  Sim3d KeyframePose(std::int64_t id) const;
+  void SetPose(FrameResult* result, const SE3d& T_kf_frame) const;
+  RevisedPose Revised(const Frame& frame, const std::optional<SE3d>& T_kf_frame) const;
+  void Record(std::int64_t frame_id, const FrameResult& result);
+  void ClearMap();
   void RebuildReference();
   /// Tries the recent keyframes for a frame lost against the current one (see
   /// SystemOptions::recent_keyframes); on success the found keyframe is current again.
-  std::optional<TrackingResult> TrackRecentKeyframes(const Frame& frame);
+  std::optional<TrackingResult> TrackRecentKeyframes(const Frame& frame, FrameResult* result);
   TrackingResult TrackFrame(const Frame& frame, FrameResult* result);
   void MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
                 const TrackingResult& tracked, FrameResult* result);
@@ -174,26 +241,41 @@ class System {
                                          const TwoViewPair& pair);
   /// `map`: the keyframe's map before any depth (it is initialised randomly here).
   void StartRandom(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
-                   InverseDepthMap map);
+                   InverseDepthMap map, FrameResult* result);
+  /// The newest revision (the frame being processed) becomes the result's own pose.
+  void TakeNewestRevision(FrameResult* result) const;
 
   PinholeCamera camera_;
   SystemOptions options_;
   Se3Tracker tracker_;
   DepthFilter depth_filter_;
   UpdateDirection update_direction_;
+  GraphBackend backend_;
+  BackendStats backend_stats_;
+  /// Finished keyframes and their poses (the map).
+  KeyframeGraph graph_;
+  /// The current keyframe's mutable depth and its published tracking reference.
   std::unique_ptr<InverseDepthMap> map_;
-  std::unique_ptr<TrackingReference> reference_;
-  std::vector<KeyframeRecord> keyframes_;
-  /// World points of finished keyframes by keyframe frame id (replaced when a keyframe that
-  /// was returned to finishes again).
-  std::map<std::int64_t, std::vector<Eigen::Vector3f>> finished_points_;
+  std::shared_ptr<const TrackingReference> reference_;
+  /// Where the current keyframe is: in the graph (returned to), or relative to its parent
+  /// until it is finished (or, for the first keyframe, in the world).
+  struct CurrentKeyframe {
+    std::int64_t id = -1;
+    std::optional<std::int64_t> parent;
+    Sim3d S_parent_kf;  ///< S_w_kf when there is no parent
+  };
+  CurrentKeyframe current_;
+  /// Mutable depth of the most recent finished keyframes, for recovery (their poses and
+  /// frozen depth are in the graph).
   struct RecentKeyframe {
     std::unique_ptr<InverseDepthMap> map;
-    std::unique_ptr<TrackingReference> reference;
-    Sim3d S_w_kf;
+    std::shared_ptr<const TrackingReference> reference;
   };
   std::deque<RecentKeyframe> recent_;  ///< newest first
-  Sim3d S_w_kf_;
+  /// Per frame (index = frame id): its anchored pose, if it has one, and its timestamp.
+  std::vector<std::optional<AnchoredPose>> frame_poses_;
+  std::vector<double> frame_timestamps_;
+  std::int64_t result_frame_id_ = 0;  ///< the frame being processed (for events)
   SE3d T_kf_last_;
   SE3d T_prev_last_;  ///< last inter-frame motion (for the constant-velocity guess)
   AffineBrightness affine_;

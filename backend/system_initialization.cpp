@@ -19,24 +19,24 @@ FrameResult System::StartFirstKeyframe(const std::shared_ptr<const Frame>& frame
   }
   if (options_.initialization == Initialization::kTwoView) {
     // Keyframe with an empty map; its depth comes from the first good two-view pair.
-    StartKeyframe(frame, Sim3d(), std::move(map));
+    StartKeyframe(frame, Sim3d(), std::move(map), &result);
     bootstrap_ = std::make_unique<TwoViewBootstrap>(camera_, options_.bootstrap);
     bootstrap_->SetReference(image);
     bootstrap_tries_ = 0;
   } else {
-    StartRandom(frame, image, std::move(map));
+    StartRandom(frame, image, std::move(map), &result);
   }
   result.status = TrackingStatus::kOk;
-  result.T_w_c = SE3d();
+  SetPose(&result, SE3d());
   result.is_keyframe = true;
   return result;
 }
 
 void System::StartRandom(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
-                         InverseDepthMap map) {
+                         InverseDepthMap map, FrameResult* result) {
   // LSD-style start: random inverse depth (mean 1) that the first frames refine.
   map.InitializeRandom(1.0f);
-  StartKeyframe(frame, Sim3d(), std::move(map));
+  StartKeyframe(frame, Sim3d(), std::move(map), result);
   depth_updates_ = 0;
   lost_in_a_row_ = 0;
   bootstrap_.reset();
@@ -91,10 +91,7 @@ std::vector<RevisedPose> System::FinishInitialisation() {
         poses->push_back(TrackAgain(*frame, T_kf_frame));
     }
     for (std::size_t i = 0; i < initial_frames_.size(); ++i) {
-      const Frame& frame = *initial_frames_[i].first;
-      RevisedPose pose{frame.Id(), frame.Timestamp(), std::nullopt};
-      if ((*poses)[i]) pose.T_w_c = (S_w_kf_ * Sim3d(*(*poses)[i])).RigidPart();
-      revised.push_back(pose);
+      revised.push_back(Revised(*initial_frames_[i].first, (*poses)[i]));
     }
   }
   initial_frames_.clear();
@@ -109,9 +106,7 @@ FrameResult System::ProcessTwoViewOnly(const std::shared_ptr<const Frame>& frame
   BufferInitialFrame(frame, SE3d());
   if (const auto pair = bootstrap_->TryFrame(image)) {
     result.revised = StartFromPair(frame, *pair);
-    result.T_w_c = result.revised.back().T_w_c;
-    result.revised.pop_back();
-    result.status = result.T_w_c ? TrackingStatus::kOk : TrackingStatus::kLost;
+    TakeNewestRevision(&result);
     return result;
   }
   result.stats.reason = "initialising";
@@ -119,9 +114,9 @@ FrameResult System::ProcessTwoViewOnly(const std::shared_ptr<const Frame>& frame
     // No usable pair: start over from random depth at this frame; the frames before it stay
     // without a pose.
     initial_frames_.clear();
-    StartRandom(frame, image, InverseDepthMap(frame, options_.depth));
+    StartRandom(frame, image, InverseDepthMap(frame, options_.depth), &result);
     result.status = TrackingStatus::kOk;
-    result.T_w_c = SE3d();
+    SetPose(&result, SE3d());
     result.is_keyframe = true;
   }
   return result;
@@ -149,9 +144,7 @@ std::optional<FrameResult> System::ProcessWhileInitialising(
     BufferInitialFrame(frame, T_kf_last_);
     result.revised = StartFromPair(pending_pair_->first, pending_pair_->second);
     pending_pair_.reset();
-    result.T_w_c = result.revised.back().T_w_c;
-    result.revised.pop_back();
-    result.status = result.T_w_c ? TrackingStatus::kOk : TrackingStatus::kLost;
+    TakeNewestRevision(&result);
     return result;
   }
   if (tracked.status == TrackingStatus::kPoor) return std::nullopt;
@@ -162,18 +155,24 @@ std::optional<FrameResult> System::ProcessWhileInitialising(
     return result;
   }
   // The start has failed: withdraw every pose given so far and start again here.
-  result.revised.push_back({map_->KeyframePtr()->Id(), map_->KeyframePtr()->Timestamp(), {}});
+  result.revised.push_back(Revised(*map_->KeyframePtr(), std::nullopt));
   for (const auto& buffered : initial_frames_) {
-    result.revised.push_back({buffered.first->Id(), buffered.first->Timestamp(), {}});
+    result.revised.push_back(Revised(*buffered.first, std::nullopt));
   }
   initial_frames_.clear();
-  keyframes_.clear();
-  finished_points_.clear();
-  recent_.clear();
-  map_.reset();
+  ClearMap();
   FrameResult restarted = StartFirstKeyframe(frame, image);
   restarted.revised = std::move(result.revised);
+  restarted.events.insert(restarted.events.begin(),
+                          {SystemEvent::Kind::kRestarted, frame->Id(), frame->Id()});
   return restarted;
+}
+
+void System::TakeNewestRevision(FrameResult* result) const {
+  const RevisedPose newest = result->revised.back();
+  result->revised.pop_back();
+  result->status = newest.T_w_c ? TrackingStatus::kOk : TrackingStatus::kLost;
+  if (newest.T_w_c) SetPose(result, newest.T_kf_frame);
 }
 
 bool System::RandomStartAgrees(const SE3d& T_kf_frame, const TwoViewPair& pair) const {
@@ -208,15 +207,15 @@ std::vector<RevisedPose> System::StartFromPair(const std::shared_ptr<const Frame
   for (const auto& [frame, unused] : buffered) {
     if (frame == pair_frame) guess = T_kf_pair_frame;
     const TrackingResult r = tracker_.Track(*reference_, *frame, {guess}, affine_);
-    RevisedPose pose{frame->Id(), frame->Timestamp(), std::nullopt};
+    std::optional<SE3d> pose;
     if (r.status != TrackingStatus::kLost) {
       previous = guess;
       guess = r.T_kf_frame;
       affine_ = r.affine;
-      pose.T_w_c = (S_w_kf_ * Sim3d(r.T_kf_frame)).RigidPart();
+      pose = r.T_kf_frame;
     }
     initial_frames_.emplace_back(frame, guess);
-    revised.push_back(pose);
+    revised.push_back(Revised(*frame, pose));
   }
   T_prev_last_ = previous.Inverse() * guess;
   T_kf_last_ = guess;

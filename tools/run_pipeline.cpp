@@ -41,7 +41,20 @@ void WriteStats(const std::string& path, const RunSummary& s) {
       {"frames", s.frames},
       {"frames_tracked", s.frames_tracked},
       {"keyframes", s.keyframes},
-      {"loop_closures", 0},
+      {"loop_closures", s.edges.loop},
+      {"keyframe_graph",
+       {{"edges",
+         {{"odometry", s.edges.odometry},
+          {"neighbour", s.edges.neighbour},
+          {"loop", s.edges.loop}}},
+        {"alignments", s.alignments},
+        {"alignments_rejected", s.alignments_rejected},
+        {"optimisations", s.optimisations},
+        {"optimisation_iterations", s.optimisation_iterations},
+        {"optimisation_ms", {{"p50", s.optimisation_ms_p50}, {"p95", s.optimisation_ms_p95}}},
+        {"bytes", s.graph_bytes},
+        {"bytes_per_keyframe",
+         s.keyframes > 0 ? s.graph_bytes / static_cast<std::size_t>(s.keyframes) : 0}}},
       {"relocalisations", 0},
       {"initialised_at_frame", s.initialised_at_frame},
       {"wall_s", s.wall_s},
@@ -67,7 +80,7 @@ RunSummary RunDataset(const RunOptions& options) {
   if (!std::filesystem::is_directory(options.out_dir)) {
     throw InputError(options.out_dir, "cannot create the output folder");
   }
-  std::vector<std::optional<StampedPose>> poses;  // by frame index; revisions overwrite
+  Trajectory online;  // the poses as reported when each frame was processed
   std::vector<double> tracking_ms, mapping_ms;
   RunSummary summary;
   const auto start = std::chrono::steady_clock::now();
@@ -79,13 +92,7 @@ RunSummary RunDataset(const RunOptions& options) {
     const FrameResult result = system.ProcessFrame(frame->image, frame->timestamp);
     ++summary.frames;
     summary.frames_tracked += result.T_w_c.has_value();
-    poses.emplace_back();
-    if (result.T_w_c) poses.back() = StampedPose{frame->timestamp, *result.T_w_c};
-    for (const RevisedPose& r : result.revised) {
-      auto& pose = poses[static_cast<std::size_t>(r.frame_id)];
-      pose.reset();
-      if (r.T_w_c) pose = StampedPose{r.timestamp, *r.T_w_c};
-    }
+    if (result.T_w_c) online.push_back(StampedPose{frame->timestamp, *result.T_w_c});
     tracking_ms.push_back(result.tracking_ms);
     mapping_ms.push_back(result.mapping_ms);
     if (options.progress) {
@@ -97,8 +104,8 @@ RunSummary RunDataset(const RunOptions& options) {
   if (options.progress) std::fprintf(stderr, "\n");
   if (summary.frames == 0) throw InputError(options.dataset, "has no frames");
   Trajectory trajectory;
-  for (const auto& pose : poses) {
-    if (pose) trajectory.push_back(*pose);
+  for (const FramePose& pose : system.Trajectory()) {
+    trajectory.push_back({pose.timestamp, pose.T_w_c});
   }
   summary.frames_tracked = static_cast<int>(trajectory.size());
   summary.initialised_at_frame = system.InitialisedAtFrame();
@@ -109,11 +116,20 @@ RunSummary RunDataset(const RunOptions& options) {
   summary.tracking_ms_p95 = Percentile(tracking_ms, 0.95);
   summary.mapping_ms_p50 = Percentile(mapping_ms, 0.5);
   summary.mapping_ms_p95 = Percentile(mapping_ms, 0.95);
+  summary.edges = system.Graph().CountEdges();
+  summary.optimisations = system.Backend().optimisations;
+  summary.optimisation_iterations = system.Backend().iterations;
+  summary.alignments = system.Backend().alignments;
+  summary.alignments_rejected = system.Backend().edges_rejected;
+  summary.optimisation_ms_p50 = Percentile(system.Backend().optimisation_ms, 0.5);
+  summary.optimisation_ms_p95 = Percentile(system.Backend().optimisation_ms, 0.95);
+  summary.graph_bytes = system.Graph().Bytes();
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   summary.peak_rss_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;
   const std::filesystem::path out(options.out_dir);
   WriteTumTrajectory((out / "trajectory.txt").string(), trajectory);
+  WriteTumTrajectory((out / "trajectory_online.txt").string(), online);
   Trajectory keyframes;
   for (const KeyframeRecord& kf : system.Keyframes()) {
     keyframes.push_back({kf.timestamp, SE3d(kf.S_w_kf.Rotation(), kf.S_w_kf.Translation())});

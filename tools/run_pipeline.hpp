@@ -29,11 +29,20 @@ struct RunSummary {
   double peak_rss_mb = 0.0;
   std::size_t map_points = 0;
   int initialised_at_frame = -1;  ///< -1: never initialised
+  /// Keyframe graph: edges by kind, optimisations and their cost.
+  EdgeCounts edges;
+  int optimisations = 0;
+  int optimisation_iterations = 0;
+  int alignments = 0;
+  int alignments_rejected = 0;
+  double optimisation_ms_p50 = 0.0, optimisation_ms_p95 = 0.0;
+  std::size_t graph_bytes = 0;  ///< memory held by the finished keyframes
 };
 
 /// Reads the dataset, rectifies each image, runs System::ProcessFrame, and writes
-/// out_dir/{trajectory.txt, keyframes.txt, map.ply, stats.json}. Throws InputError for bad
-/// input (naming the file) and std::invalid_argument for bad options.
+/// out_dir/{trajectory.txt (every posed frame through the final, optimised keyframe graph),
+/// trajectory_online.txt (the poses as reported live), keyframes.txt, map.ply, stats.json}. Throws
+/// InputError for bad input (naming the file) and std::invalid_argument for bad options.
 RunSummary RunDataset(const RunOptions& options);
 
 }  // namespace parallax

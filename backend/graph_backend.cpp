@@ -1,0 +1,113 @@
+#include "backend/graph_backend.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/angles.hpp"
+#include "core/check.hpp"
+
+namespace parallax {
+
+void GraphBackendOptions::Check() const {
+  alignment.Check();
+  optimizer.Check();
+  CheckOption(neighbour_max_distance >= 0.0, "GraphBackendOptions", "neighbour_max_distance",
+              "must be >= 0");
+  CheckOption(neighbour_max_angle_deg >= 0.0, "GraphBackendOptions", "neighbour_max_angle_deg",
+              "must be >= 0");
+  CheckOption(max_neighbours >= 0, "GraphBackendOptions", "max_neighbours", "must be >= 0");
+  CheckOption(max_reciprocal_mahalanobis > 0.0, "GraphBackendOptions", "max_reciprocal_mahalanobis",
+              "must be > 0");
+  CheckOption(information_scale > 0.0, "GraphBackendOptions", "information_scale", "must be > 0");
+  CheckOption(fallback_odometry_information > 0.0, "GraphBackendOptions",
+              "fallback_odometry_information", "must be > 0");
+}
+
+GraphBackend::GraphBackend(const GraphBackendOptions& options)
+    : options_(options), aligner_(options.alignment), optimizer_(options.optimizer) {
+  options_.Check();
+}
+
+GraphBackend::Alignment GraphBackend::Align(const Keyframe& a, const Keyframe& b,
+                                            const Sim3d& S_a_b_guess, BackendReport* report) {
+  Alignment out;
+  if (!a.reference || !b.reference) return out;
+  report->alignments += 2;
+  const Sim3TrackingResult a_b = aligner_.Track(*a.reference, *b.reference, S_a_b_guess);
+  if (a_b.status != TrackingStatus::kOk) return out;
+  const Sim3TrackingResult b_a =
+      aligner_.Track(*b.reference, *a.reference, a_b.S_ref_other.Inverse());
+  if (b_a.status != TrackingStatus::kOk) return out;
+  if (!(ReciprocalMahalanobis(a_b, b_a) < options_.max_reciprocal_mahalanobis)) return out;
+  out.accepted = true;
+  out.S_a_b = a_b.S_ref_other;
+  // The tracker's information is for S' = Exp(eps) S_a_b; the graph residual of the edge is
+  // r = Adj(S_a_b^-1) eps to first order, so Omega_r = Adj(S)^T Omega_eps Adj(S).
+  const Matrix7d adjoint = out.S_a_b.Adjoint();
+  out.information = options_.information_scale * adjoint.transpose() * a_b.information * adjoint;
+  out.information = 0.5 * (out.information + out.information.transpose()).eval();
+  return out;
+}
+
+std::vector<std::int64_t> GraphBackend::NeighbourCandidates(
+    const KeyframeGraph& graph, std::int64_t id, std::optional<std::int64_t> parent) const {
+  const Sim3d& S_w_kf = graph.Pose(id);
+  const Eigen::Vector3d axis = S_w_kf.Rotation() * Eigen::Vector3d::UnitZ();
+  std::vector<std::pair<double, std::int64_t>> near;
+  for (const std::int64_t other : graph.Ids()) {
+    if (other == id || other == parent || graph.HasEdge(id, other)) continue;
+    const Sim3d& S_w_other = graph.Pose(other);
+    // Distance in units of the finished keyframe's mean depth (its scale in the world).
+    const double distance =
+        (S_w_other.Translation() - S_w_kf.Translation()).norm() / S_w_kf.Scale();
+    const double angle = AngleBetweenDeg(axis, S_w_other.Rotation() * Eigen::Vector3d::UnitZ());
+    if (distance <= options_.neighbour_max_distance && angle <= options_.neighbour_max_angle_deg) {
+      near.emplace_back(distance, other);
+    }
+  }
+  std::sort(near.begin(), near.end());
+  std::vector<std::int64_t> ids;
+  for (std::size_t k = 0; k < near.size() && static_cast<int>(k) < options_.max_neighbours; ++k) {
+    ids.push_back(near[k].second);
+  }
+  return ids;
+}
+
+BackendReport GraphBackend::KeyframeFinished(KeyframeGraph* graph, std::int64_t id,
+                                             std::optional<std::int64_t> parent,
+                                             const Sim3d& S_parent_kf) {
+  BackendReport report;
+  const Keyframe& kf = graph->Get(id);
+  if (parent && graph->Contains(*parent) && !graph->HasEdge(*parent, id)) {
+    PoseGraphEdge edge;
+    edge.i = *parent;
+    edge.j = id;
+    edge.kind = EdgeKind::kOdometry;
+    const Alignment a = Align(graph->Get(*parent), kf, S_parent_kf, &report);
+    // The chain's measurement is what tracking used; the alignment, when it agrees, says how
+    // well it is known. A failed alignment keeps the chain with a fixed weight.
+    edge.S_i_j = a.accepted ? a.S_a_b : S_parent_kf;
+    edge.information =
+        a.accepted ? a.information
+                   : Matrix7d(options_.fallback_odometry_information * Matrix7d::Identity());
+    graph->AddEdge(edge);
+    ++report.edges_added;
+    report.edges_rejected += a.accepted ? 0 : 1;
+  }
+  for (const std::int64_t other : NeighbourCandidates(*graph, id, parent)) {
+    const Sim3d guess = graph->Pose(other).Inverse() * graph->Pose(id);
+    const Alignment a = Align(graph->Get(other), kf, guess, &report);
+    if (!a.accepted) {
+      ++report.edges_rejected;
+      continue;
+    }
+    graph->AddEdge(PoseGraphEdge{other, id, a.S_a_b, a.information, EdgeKind::kNeighbour});
+    ++report.edges_added;
+  }
+  if (report.edges_added > 0 && graph->Size() >= 2) {
+    report.optimisation = optimizer_.Optimize(&graph->Poses());
+  }
+  return report;
+}
+
+}  // namespace parallax

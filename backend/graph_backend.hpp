@@ -1,0 +1,76 @@
+#pragma once
+// The backend stage: constraint search for finished keyframes (direct Sim(3) alignment with
+// the reciprocal check) and pose-graph optimisation of the keyframe graph
+// (docs/architecture.md, "Backend").
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "backend/keyframe_graph.hpp"
+#include "backend/pose_graph_optimizer.hpp"
+#include "tracking/sim3_tracker.hpp"
+
+namespace parallax {
+
+struct GraphBackendOptions {
+  Sim3TrackerOptions alignment;
+  /// Neighbour candidates: keyframes (other than the parent) whose centre is within this
+  /// distance of the finished keyframe's, relative to its mean depth, and whose optical axes
+  /// differ by less than `neighbour_max_angle_deg`; the nearest `max_neighbours` are aligned.
+  double neighbour_max_distance = 1.0;
+  double neighbour_max_angle_deg = 30.0;
+  int max_neighbours = 2;
+  /// An alignment is an edge only if both directions converge ("ok") and their reciprocal
+  /// Mahalanobis distance (ReciprocalMahalanobis) is below this.
+  double max_reciprocal_mahalanobis = 1.0;
+  /// Scale of the alignment's information matrix in the graph: direct alignment's Hessian
+  /// treats pixels as independent and is overconfident (docs/math/pose_graph.md).
+  double information_scale = 1e-2;
+  /// Information of an odometry edge whose alignment fails (the tracking chain's
+  /// measurement is kept so the graph stays connected): diagonal, per residual unit^2.
+  double fallback_odometry_information = 1e4;
+  PoseGraphOptimizerOptions optimizer{
+      .kernel = RobustKernel::kHuber, .kernel_width = 2.0, .max_iterations = 20};
+
+  void Check() const;
+};
+
+/// What the backend did for one finished keyframe.
+struct BackendReport {
+  int alignments = 0;  ///< Sim(3) alignments run (each direction counts)
+  int edges_added = 0;
+  int edges_rejected = 0;  ///< candidates that failed convergence or the reciprocal check
+  std::optional<PoseGraphSummary> optimisation;  ///< empty when nothing was optimised
+};
+
+class GraphBackend {
+ public:
+  explicit GraphBackend(const GraphBackendOptions& options = {});
+
+  /// Keyframe `id` was finished (it is in the graph): the odometry edge to `parent` with the
+  /// tracking chain's measurement S_parent_kf (refined and weighted by alignment), edges to
+  /// nearby keyframes, and a warm-started optimisation of the graph.
+  BackendReport KeyframeFinished(KeyframeGraph* graph, std::int64_t id,
+                                 std::optional<std::int64_t> parent, const Sim3d& S_parent_kf);
+
+  const GraphBackendOptions& Options() const { return options_; }
+
+ private:
+  struct Alignment {
+    bool accepted = false;
+    Sim3d S_a_b;
+    Matrix7d information = Matrix7d::Zero();  ///< in pose-graph residual coordinates
+  };
+  /// Aligns keyframes a and b both ways from the guess S_a_b.
+  Alignment Align(const Keyframe& a, const Keyframe& b, const Sim3d& S_a_b_guess,
+                  BackendReport* report);
+  std::vector<std::int64_t> NeighbourCandidates(const KeyframeGraph& graph, std::int64_t id,
+                                                std::optional<std::int64_t> parent) const;
+
+  GraphBackendOptions options_;
+  Sim3Tracker aligner_;
+  PoseGraphOptimizer optimizer_;
+};
+
+}  // namespace parallax

@@ -1,0 +1,102 @@
+#include "backend/keyframe_graph.hpp"
+
+#include <algorithm>
+
+#include "depth/depth_map.hpp"
+
+namespace parallax {
+
+FrozenDepth FrozenDepth::FromMap(const InverseDepthMap& map) {
+  FrozenDepth d;
+  d.width = map.Width();
+  d.height = map.Height();
+  for (int y = 0; y < map.Height(); ++y) {
+    for (int x = 0; x < map.Width(); ++x) {
+      const std::size_t i = map.Index(x, y);
+      if (!map.valid[i]) continue;
+      d.pixel.push_back(y * map.Width() + x);
+      d.idepth.push_back(map.idepth_smoothed[i]);
+      d.variance.push_back(map.variance_smoothed[i]);
+      d.confirmed.push_back(map.IsConfirmed(i) ? 1 : 0);
+    }
+  }
+  return d;
+}
+
+void FrozenDepth::ToImages(ImageF* idepth_image, ImageF* variance_image) const {
+  *idepth_image = ImageF(width, height, 0.0f);
+  *variance_image = ImageF(width, height, 0.0f);
+  for (std::size_t k = 0; k < pixel.size(); ++k) {
+    idepth_image->Data()[pixel[k]] = idepth[k];
+    variance_image->Data()[pixel[k]] = variance[k];
+  }
+}
+
+std::size_t FrozenDepth::Bytes() const {
+  return pixel.capacity() * sizeof(std::int32_t) + idepth.capacity() * sizeof(float) +
+         variance.capacity() * sizeof(float) + confirmed.capacity();
+}
+
+void KeyframeGraph::Upsert(std::shared_ptr<const Keyframe> keyframe, const Sim3d& S_w_kf) {
+  const std::int64_t id = keyframe->id;
+  if (!Contains(id)) poses_.SetVertex(id, S_w_kf, keyframes_.empty());
+  keyframes_[id] = std::move(keyframe);
+}
+
+bool KeyframeGraph::HasEdge(std::int64_t a, std::int64_t b) const {
+  return std::any_of(poses_.Edges().begin(), poses_.Edges().end(), [&](const PoseGraphEdge& e) {
+    return (e.i == a && e.j == b) || (e.i == b && e.j == a);
+  });
+}
+
+EdgeCounts KeyframeGraph::CountEdges() const {
+  EdgeCounts c;
+  for (const PoseGraphEdge& e : poses_.Edges()) {
+    c.odometry += e.kind == EdgeKind::kOdometry;
+    c.neighbour += e.kind == EdgeKind::kNeighbour;
+    c.loop += e.kind == EdgeKind::kLoop;
+  }
+  return c;
+}
+
+std::vector<Eigen::Vector3f> KeyframeGraph::MapPoints() const {
+  std::vector<Eigen::Vector3f> points;
+  for (const auto& [id, kf] : keyframes_) {
+    const Sim3d& S_w_kf = Pose(id);
+    const PinholeCamera& K = kf->frame->Camera(0);
+    const FrozenDepth& d = kf->depth;
+    for (std::size_t k = 0; k < d.Size(); ++k) {
+      if (!d.confirmed[k]) continue;
+      const Eigen::Vector2d px(d.pixel[k] % d.width, d.pixel[k] / d.width);
+      const Eigen::Vector3d p = K.Unproject(px) / d.idepth[k];
+      points.push_back((S_w_kf * p).cast<float>());
+    }
+  }
+  return points;
+}
+
+std::size_t KeyframeGraph::Bytes() const {
+  std::size_t bytes = 0;
+  for (const auto& [id, kf] : keyframes_) {
+    bytes += kf->depth.Bytes() + sizeof(Keyframe);
+    const ImagePyramid& pyramid = kf->frame->Pyramid();
+    for (int l = 0; l < pyramid.NumLevels(); ++l) {
+      const PyramidLevel& level = pyramid.Level(l);
+      // intensity, dx, dy, grad_sq
+      bytes += static_cast<std::size_t>(level.Width() * level.Height()) * sizeof(float) * 4;
+    }
+    if (kf->reference) {
+      for (int l = 0; l < kf->reference->NumLevels(); ++l) {
+        bytes += kf->reference->Level(l).Size() * 7 * sizeof(float);
+      }
+    }
+  }
+  return bytes;
+}
+
+void KeyframeGraph::Clear() {
+  keyframes_.clear();
+  poses_ = PoseGraph();
+}
+
+}  // namespace parallax

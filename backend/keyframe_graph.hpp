@@ -1,0 +1,93 @@
+#pragma once
+// The map: every finished keyframe with its frozen semi-dense depth (keyframe coordinates),
+// its pose S_w_kf (held once, in the pose graph) and the edges between keyframes
+// (docs/architecture.md, "Keyframe graph").
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <vector>
+
+#include "backend/pose_graph.hpp"
+#include "core/frame.hpp"
+#include "core/image.hpp"
+#include "tracking/tracking_reference.hpp"
+
+namespace parallax {
+
+class InverseDepthMap;
+
+/// Semi-dense inverse depth of a finished keyframe, stored sparsely (structure of arrays):
+/// pixel index y * width + x, smoothed inverse depth (1/keyframe unit), its variance, and
+/// whether stereo confirmed it (random and hole-filled hypotheses are not exported as map
+/// points but still help tracking).
+struct FrozenDepth {
+  int width = 0;
+  int height = 0;
+  std::vector<std::int32_t> pixel;
+  std::vector<float> idepth;
+  std::vector<float> variance;
+  std::vector<std::uint8_t> confirmed;
+
+  /// The valid pixels of `map` (smoothed estimates).
+  static FrozenDepth FromMap(const InverseDepthMap& map);
+  /// Keyframe-sized images (0 where no estimate), e.g. for a TrackingReference.
+  void ToImages(ImageF* idepth_image, ImageF* variance_image) const;
+  std::size_t Size() const { return pixel.size(); }
+  std::size_t Bytes() const;
+};
+
+/// A finished keyframe. Immutable once in the graph, except that a keyframe the tracker
+/// returned to and refined again is replaced as a whole.
+struct Keyframe {
+  std::int64_t id = 0;  ///< the id of its frame
+  double timestamp = 0.0;
+  std::shared_ptr<const Frame> frame;
+  FrozenDepth depth;
+  std::shared_ptr<const TrackingReference> reference;
+};
+
+/// Counts by edge kind.
+struct EdgeCounts {
+  int odometry = 0;
+  int neighbour = 0;
+  int loop = 0;
+};
+
+/// Owns the finished keyframes and the Sim(3) pose graph over them.
+class KeyframeGraph {
+ public:
+  /// Adds a finished keyframe at pose S_w_kf, or replaces the data of one already in the
+  /// graph (its optimised pose is kept; S_w_kf is then ignored). The first keyframe added is
+  /// the gauge (fixed in optimisation).
+  void Upsert(std::shared_ptr<const Keyframe> keyframe, const Sim3d& S_w_kf);
+  bool Contains(std::int64_t id) const { return keyframes_.count(id) > 0; }
+  /// Throws std::out_of_range for an unknown id.
+  const Keyframe& Get(std::int64_t id) const { return *keyframes_.at(id); }
+  const std::shared_ptr<const Keyframe>& GetPtr(std::int64_t id) const { return keyframes_.at(id); }
+  /// Keyframe-to-world similarity (scale: the keyframe's normalised depth unit).
+  const Sim3d& Pose(std::int64_t id) const { return poses_.Pose(id); }
+  /// Ids in ascending order (frame order).
+  std::vector<std::int64_t> Ids() const { return poses_.VertexIds(); }
+  std::size_t Size() const { return keyframes_.size(); }
+
+  void AddEdge(const PoseGraphEdge& edge) { poses_.AddEdge(edge); }
+  bool HasEdge(std::int64_t a, std::int64_t b) const;
+  EdgeCounts CountEdges() const;
+  /// The pose graph, for the optimiser (the only place poses change).
+  PoseGraph& Poses() { return poses_; }
+  const PoseGraph& Poses() const { return poses_; }
+
+  /// World points of every keyframe's confirmed depth through its current pose.
+  std::vector<Eigen::Vector3f> MapPoints() const;
+  /// Memory held by the keyframes (frozen depth, tracking references, frame pyramids).
+  std::size_t Bytes() const;
+  void Clear();
+
+ private:
+  std::map<std::int64_t, std::shared_ptr<const Keyframe>> keyframes_;
+  PoseGraph poses_;
+};
+
+}  // namespace parallax
