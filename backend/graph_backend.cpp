@@ -23,22 +23,31 @@ void GraphBackendOptions::Check() const {
               "fallback_odometry_information", "must be > 0");
 }
 
-GraphBackend::GraphBackend(const GraphBackendOptions& options)
-    : options_(options), aligner_(options.alignment), optimizer_(options.optimizer) {
+GraphBackend::GraphBackend(const GraphBackendOptions& options, const KeyframeBuildOptions& build)
+    : options_(options), build_(build), aligner_(options.alignment), optimizer_(options.optimizer) {
   options_.Check();
 }
 
-GraphBackend::Alignment GraphBackend::Align(const Keyframe& a, const Keyframe& b,
-                                            const Sim3d& S_a_b_guess, BackendReport* report) {
+GraphBackend::Alignment GraphBackend::Align(const KeyframeGraph& graph, std::int64_t a_id,
+                                            std::int64_t b_id, const Sim3d& S_a_b_guess,
+                                            BackendReport* report) {
   Alignment out;
-  if (!a.reference || !b.reference) return out;
+  const auto a_ptr =
+      Materialize(graph.GetPtr(a_id), build_.camera, build_.pyramid, build_.reference);
+  const auto b_ptr =
+      Materialize(graph.GetPtr(b_id), build_.camera, build_.pyramid, build_.reference);
+  const Keyframe& a = *a_ptr;
+  const Keyframe& b = *b_ptr;
   report->alignments += 2;
   const Sim3TrackingResult a_b = aligner_.Track(*a.reference, *b.reference, S_a_b_guess);
   if (a_b.status != TrackingStatus::kOk) return out;
   const Sim3TrackingResult b_a =
       aligner_.Track(*b.reference, *a.reference, a_b.S_ref_other.Inverse());
   if (b_a.status != TrackingStatus::kOk) return out;
-  if (!(ReciprocalMahalanobis(a_b, b_a) < options_.max_reciprocal_mahalanobis)) return out;
+  // The distance with the graph's (scaled) information: scaling the information by s
+  // scales the distance by s.
+  const double distance = options_.information_scale * ReciprocalMahalanobis(a_b, b_a);
+  if (!(distance < options_.max_reciprocal_mahalanobis)) return out;
   out.accepted = true;
   out.S_a_b = a_b.S_ref_other;
   // The tracker's information is for S' = Exp(eps) S_a_b; the graph residual of the edge is
@@ -77,16 +86,15 @@ BackendReport GraphBackend::KeyframeFinished(KeyframeGraph* graph, std::int64_t 
                                              std::optional<std::int64_t> parent,
                                              const Sim3d& S_parent_kf) {
   BackendReport report;
-  const Keyframe& kf = graph->Get(id);
   if (parent && graph->Contains(*parent) && !graph->HasEdge(*parent, id)) {
     PoseGraphEdge edge;
     edge.i = *parent;
     edge.j = id;
     edge.kind = EdgeKind::kOdometry;
-    const Alignment a = Align(graph->Get(*parent), kf, S_parent_kf, &report);
+    const Alignment a = Align(*graph, *parent, id, S_parent_kf, &report);
     // The chain's measurement is what tracking used; the alignment, when it agrees, says how
     // well it is known. A failed alignment keeps the chain with a fixed weight.
-    edge.S_i_j = a.accepted ? a.S_a_b : S_parent_kf;
+    edge.S_i_j = a.accepted && options_.odometry_from_alignment ? a.S_a_b : S_parent_kf;
     edge.information =
         a.accepted ? a.information
                    : Matrix7d(options_.fallback_odometry_information * Matrix7d::Identity());
@@ -96,7 +104,7 @@ BackendReport GraphBackend::KeyframeFinished(KeyframeGraph* graph, std::int64_t 
   }
   for (const std::int64_t other : NeighbourCandidates(*graph, id, parent)) {
     const Sim3d guess = graph->Pose(other).Inverse() * graph->Pose(id);
-    const Alignment a = Align(graph->Get(other), kf, guess, &report);
+    const Alignment a = Align(*graph, other, id, guess, &report);
     if (!a.accepted) {
       ++report.edges_rejected;
       continue;

@@ -22,14 +22,20 @@ struct GraphBackendOptions {
   double neighbour_max_angle_deg = 30.0;
   int max_neighbours = 2;
   /// An alignment is an edge only if both directions converge ("ok") and their reciprocal
-  /// Mahalanobis distance (ReciprocalMahalanobis) is below this.
-  double max_reciprocal_mahalanobis = 1.0;
+  /// Mahalanobis distance, with the scaled information below, is under this (chi^2 with 7
+  /// degrees of freedom: 24.3 is its 99.9% quantile).
+  double max_reciprocal_mahalanobis = 24.3;
   /// Scale of the alignment's information matrix in the graph: direct alignment's Hessian
-  /// treats pixels as independent and is overconfident (docs/math/pose_graph.md).
-  double information_scale = 1e-2;
+  /// treats pixels as independent and is overconfident. Chosen on the KITTI and TUM clips
+  /// (the tuning set) so that the median reciprocal distance of parent alignments, ~1,500
+  /// unscaled, becomes chi^2(7)'s median 6.35 (docs/math/pose_graph.md).
+  double information_scale = 4e-3;
   /// Information of an odometry edge whose alignment fails (the tracking chain's
   /// measurement is kept so the graph stays connected): diagonal, per residual unit^2.
   double fallback_odometry_information = 1e4;
+  /// true: an odometry edge measures what the keyframe alignment found; false: the tracking
+  /// chain's S_parent_kf, weighted by the alignment's information.
+  bool odometry_from_alignment = true;
   PoseGraphOptimizerOptions optimizer{
       .kernel = RobustKernel::kHuber, .kernel_width = 2.0, .max_iterations = 20};
 
@@ -44,9 +50,16 @@ struct BackendReport {
   std::optional<PoseGraphSummary> optimisation;  ///< empty when nothing was optimised
 };
 
+/// How compacted keyframes are rebuilt for alignment (see Materialize).
+struct KeyframeBuildOptions {
+  PinholeCamera camera;
+  PyramidOptions pyramid;
+  TrackingReferenceOptions reference;
+};
+
 class GraphBackend {
  public:
-  explicit GraphBackend(const GraphBackendOptions& options = {});
+  GraphBackend(const GraphBackendOptions& options, const KeyframeBuildOptions& build);
 
   /// Keyframe `id` was finished (it is in the graph): the odometry edge to `parent` with the
   /// tracking chain's measurement S_parent_kf (refined and weighted by alignment), edges to
@@ -63,12 +76,13 @@ class GraphBackend {
     Matrix7d information = Matrix7d::Zero();  ///< in pose-graph residual coordinates
   };
   /// Aligns keyframes a and b both ways from the guess S_a_b.
-  Alignment Align(const Keyframe& a, const Keyframe& b, const Sim3d& S_a_b_guess,
-                  BackendReport* report);
+  Alignment Align(const KeyframeGraph& graph, std::int64_t a, std::int64_t b,
+                  const Sim3d& S_a_b_guess, BackendReport* report);
   std::vector<std::int64_t> NeighbourCandidates(const KeyframeGraph& graph, std::int64_t id,
                                                 std::optional<std::int64_t> parent) const;
 
   GraphBackendOptions options_;
+  KeyframeBuildOptions build_;
   Sim3Tracker aligner_;
   PoseGraphOptimizer optimizer_;
 };

@@ -59,11 +59,36 @@ EdgeCounts KeyframeGraph::CountEdges() const {
   return c;
 }
 
-std::vector<Eigen::Vector3f> KeyframeGraph::MapPoints() const {
+std::shared_ptr<const Keyframe> Materialize(const std::shared_ptr<const Keyframe>& keyframe,
+                                            const PinholeCamera& camera,
+                                            const PyramidOptions& pyramid,
+                                            const TrackingReferenceOptions& reference) {
+  if (!keyframe->IsCompact()) return keyframe;
+  auto full = std::make_shared<Keyframe>(*keyframe);
+  full->frame = std::make_shared<const Frame>(keyframe->id, keyframe->timestamp, camera,
+                                              keyframe->image, pyramid);
+  ImageF idepth, variance;
+  keyframe->depth.ToImages(&idepth, &variance);
+  full->reference =
+      std::make_shared<const TrackingReference>(full->frame, idepth, variance, reference);
+  return full;
+}
+
+void KeyframeGraph::Compact(const std::vector<std::int64_t>& keep) {
+  for (auto& [id, kf] : keyframes_) {
+    if (kf->IsCompact() || std::find(keep.begin(), keep.end(), id) != keep.end()) continue;
+    auto compact = std::make_shared<Keyframe>(*kf);
+    compact->frame.reset();
+    compact->reference.reset();
+    kf = std::move(compact);
+  }
+}
+
+std::vector<Eigen::Vector3f> KeyframeGraph::MapPoints(const PinholeCamera& camera) const {
   std::vector<Eigen::Vector3f> points;
   for (const auto& [id, kf] : keyframes_) {
     const Sim3d& S_w_kf = Pose(id);
-    const PinholeCamera& K = kf->frame->Camera(0);
+    const PinholeCamera& K = camera;
     const FrozenDepth& d = kf->depth;
     for (std::size_t k = 0; k < d.Size(); ++k) {
       if (!d.confirmed[k]) continue;
@@ -78,7 +103,8 @@ std::vector<Eigen::Vector3f> KeyframeGraph::MapPoints() const {
 std::size_t KeyframeGraph::Bytes() const {
   std::size_t bytes = 0;
   for (const auto& [id, kf] : keyframes_) {
-    bytes += kf->depth.Bytes() + sizeof(Keyframe);
+    bytes += kf->depth.Bytes() + sizeof(Keyframe) + kf->image.NumPixels();
+    if (!kf->frame) continue;
     const ImagePyramid& pyramid = kf->frame->Pyramid();
     for (int l = 0; l < pyramid.NumLevels(); ++l) {
       const PyramidLevel& level = pyramid.Level(l);

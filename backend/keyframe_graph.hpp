@@ -39,14 +39,27 @@ struct FrozenDepth {
 };
 
 /// A finished keyframe. Immutable once in the graph, except that a keyframe the tracker
-/// returned to and refined again is replaced as a whole.
+/// returned to and refined again is replaced as a whole, and that old keyframes are
+/// compacted: their frame pyramid and tracking reference (~10 MB at 640x480) are dropped and
+/// rebuilt from `image` and `depth` when a later stage needs them (Materialize).
 struct Keyframe {
   std::int64_t id = 0;  ///< the id of its frame
   double timestamp = 0.0;
-  std::shared_ptr<const Frame> frame;
+  ImageU8 image;  ///< the undistorted 8-bit image (pyramid level 0)
   FrozenDepth depth;
-  std::shared_ptr<const TrackingReference> reference;
+  std::shared_ptr<const Frame> frame;                  ///< null when compacted
+  std::shared_ptr<const TrackingReference> reference;  ///< null when compacted
+
+  bool IsCompact() const { return !frame || !reference; }
 };
+
+/// The keyframe with its frame and tracking reference rebuilt if it was compacted (the same
+/// data as before compaction: Frame and TrackingReference are deterministic functions of the
+/// image and the depth).
+std::shared_ptr<const Keyframe> Materialize(const std::shared_ptr<const Keyframe>& keyframe,
+                                            const PinholeCamera& camera,
+                                            const PyramidOptions& pyramid,
+                                            const TrackingReferenceOptions& reference);
 
 /// Counts by edge kind.
 struct EdgeCounts {
@@ -72,6 +85,9 @@ class KeyframeGraph {
   std::vector<std::int64_t> Ids() const { return poses_.VertexIds(); }
   std::size_t Size() const { return keyframes_.size(); }
 
+  /// Drops the frame and tracking reference of every keyframe not in `keep` (ids).
+  void Compact(const std::vector<std::int64_t>& keep);
+
   void AddEdge(const PoseGraphEdge& edge) { poses_.AddEdge(edge); }
   bool HasEdge(std::int64_t a, std::int64_t b) const;
   EdgeCounts CountEdges() const;
@@ -79,8 +95,9 @@ class KeyframeGraph {
   PoseGraph& Poses() { return poses_; }
   const PoseGraph& Poses() const { return poses_; }
 
-  /// World points of every keyframe's confirmed depth through its current pose.
-  std::vector<Eigen::Vector3f> MapPoints() const;
+  /// World points of every keyframe's confirmed depth through its current pose; `camera`
+  /// is the (level-0) camera of the keyframes.
+  std::vector<Eigen::Vector3f> MapPoints(const PinholeCamera& camera) const;
   /// Memory held by the keyframes (frozen depth, tracking references, frame pyramids).
   std::size_t Bytes() const;
   void Clear();

@@ -199,6 +199,8 @@ class System {
   RevisedPose Revised(const Frame& frame, const std::optional<SE3d>& T_kf_frame) const;
   void Record(std::int64_t frame_id, const FrameResult& result);
   void ClearMap();
+  /// Keyframes other than the current and the recent ones drop their frame and reference.
+  void CompactOldKeyframes();
   void RebuildReference();
   /// Tries the recent keyframes for a frame lost against the current one (see
   /// SystemOptions::recent_keyframes); on success the found keyframe is current again.

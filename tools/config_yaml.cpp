@@ -84,7 +84,18 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"update_direction_min_baseline", Set(&o->update_direction.min_relative_baseline)},
         {"update_direction_recheck_growth", Set(&o->update_direction.recheck_growth)},
         {"update_direction_max_axis_angle_deg", Set(&o->update_direction.max_axis_angle_deg)},
-        {"update_direction_reuse_max_angle_deg", Set(&o->update_direction.reuse_max_angle_deg)}}},
+        {"update_direction_reuse_max_angle_deg", Set(&o->update_direction.reuse_max_angle_deg)},
+        {"optimize_graph", Set(&o->optimize_graph)}}},
+      {"backend",
+       {{"neighbour_max_distance", Set(&o->backend.neighbour_max_distance)},
+        {"neighbour_max_angle_deg", Set(&o->backend.neighbour_max_angle_deg)},
+        {"max_neighbours", Set(&o->backend.max_neighbours)},
+        {"max_reciprocal_mahalanobis", Set(&o->backend.max_reciprocal_mahalanobis)},
+        {"information_scale", Set(&o->backend.information_scale)},
+        {"fallback_odometry_information", Set(&o->backend.fallback_odometry_information)},
+        {"odometry_from_alignment", Set(&o->backend.odometry_from_alignment)},
+        {"optimizer_max_iterations", Set(&o->backend.optimizer.max_iterations)},
+        {"optimizer_kernel_width", Set(&o->backend.optimizer.kernel_width)}}},
   };
 }
 
@@ -107,9 +118,9 @@ void ApplyConfigYaml(const std::string& path, SystemOptions* options) {
     const std::string name = section.first.as<std::string>();
     const auto found = sections.find(name);
     if (found == sections.end()) {
-      throw InputError(
-          path, LineOf(section.first),
-          "unknown section '" + name + "' (expected pyramid, reference, tracker, depth or system)");
+      throw InputError(path, LineOf(section.first),
+                       "unknown section '" + name +
+                           "' (expected pyramid, reference, tracker, depth, system or backend)");
     }
     if (!section.second.IsMap())
       throw InputError(path, LineOf(section.second), "section '" + name + "' must be a mapping");
