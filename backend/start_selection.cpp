@@ -17,33 +17,24 @@ struct System::StartSnapshot {
   std::unique_ptr<InverseDepthMap> map;
   std::shared_ptr<const TrackingReference> reference;  // immutable: shared, not copied
   std::vector<std::pair<std::shared_ptr<const Frame>, SE3d>> frames;
-  AffineBrightness affine;
-  SE3d T_kf_last, T_prev_last;
-  int frames_in_keyframe = 0;
+  MotionState motion;
   int depth_updates = 0;
 };
 
 System::StartSnapshot System::SaveStart() const {
   StartSnapshot s;
-  s.map = std::make_unique<InverseDepthMap>(*map_);
-  s.reference = reference_;
+  s.map = std::make_unique<InverseDepthMap>(mapper_.Map());
+  s.reference = mapper_.Reference();
   s.frames = initial_frames_;
-  s.affine = affine_;
-  s.T_kf_last = T_kf_last_;
-  s.T_prev_last = T_prev_last_;
-  s.frames_in_keyframe = frames_in_keyframe_;
+  s.motion = tracker_.State();
   s.depth_updates = depth_updates_;
   return s;
 }
 
 void System::RestoreStart(StartSnapshot snapshot) {
-  map_ = std::move(snapshot.map);
-  reference_ = std::move(snapshot.reference);
+  mapper_.Restore(std::move(snapshot.map), std::move(snapshot.reference));
   initial_frames_ = std::move(snapshot.frames);
-  affine_ = snapshot.affine;
-  T_kf_last_ = snapshot.T_kf_last;
-  T_prev_last_ = snapshot.T_prev_last;
-  frames_in_keyframe_ = snapshot.frames_in_keyframe;
+  tracker_.SetState(snapshot.motion);
   depth_updates_ = snapshot.depth_updates;
 }
 
@@ -53,7 +44,7 @@ double System::BufferedResidual(BufferedPoses* poses) {
   double sum = 0.0;
   AffineBrightness affine;  // carried along: exposure changes smoothly between frames
   for (const auto& [frame, T_kf_frame] : initial_frames_) {
-    const TrackingResult r = tracker_.Track(*reference_, *frame, {T_kf_frame}, affine);
+    const TrackingResult r = tracker_.TrackFrom(*mapper_.Reference(), *frame, T_kf_frame, affine);
     if (r.status == TrackingStatus::kLost) {
       sum += kLostFrameResidual;
       poses->emplace_back();
@@ -69,16 +60,14 @@ double System::BufferedResidual(BufferedPoses* poses) {
 void System::RefineWithBufferedFrames() {
   AffineBrightness affine;
   for (auto& [frame, T_kf_frame] : initial_frames_) {
-    const TrackingResult r = tracker_.Track(*reference_, *frame, {T_kf_frame}, affine);
+    const TrackingResult r = tracker_.TrackFrom(*mapper_.Reference(), *frame, T_kf_frame, affine);
     if (r.status != TrackingStatus::kOk) continue;
     affine = r.affine;
     T_kf_frame = r.T_kf_frame;
-    const double baseline = r.T_kf_frame.Translation().norm() * map_->MeanSmoothedIdepth();
+    const double baseline = r.T_kf_frame.Translation().norm() * mapper_.Map().MeanSmoothedIdepth();
     if (baseline <= options_.min_update_baseline) continue;
-    depth_filter_.Update(
-        map_.get(), StereoFrame{frame.get(), r.T_kf_frame.Inverse(), r.affine.Gain(), r.affine.b,
-                                static_cast<float>(1.0 - r.stats.good_ratio)});
-    RebuildReference();
+    mapper_.Update(*frame, r.T_kf_frame, r);
+    mapper_.PublishReference();
   }
 }
 

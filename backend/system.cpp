@@ -49,17 +49,10 @@ System::System(const PinholeCamera& camera, const SystemOptions& options)
     : camera_(camera),
       options_(options),
       tracker_(options.tracker),
-      depth_filter_(options.depth),
-      update_direction_(camera, options.update_direction),
+      mapper_(camera, options.depth, options.update_direction, options.reference,
+              options.recent_keyframes),
       backend_(options.backend, KeyframeBuildOptions{camera, options.pyramid, options.reference}) {
   options_.Check();
-}
-
-void System::RebuildReference() {
-  ImageF idepth, variance;
-  map_->ExportSmoothed(&idepth, &variance);
-  reference_ = std::make_shared<const TrackingReference>(map_->KeyframePtr(), idepth, variance,
-                                                         options_.reference);
 }
 
 Sim3d System::KeyframePose(std::int64_t id) const {
@@ -91,19 +84,7 @@ RevisedPose System::Revised(const Frame& frame, const std::optional<SE3d>& T_kf_
 }
 
 void System::FinishCurrentKeyframe(FrameResult* result) {
-  auto keyframe = std::make_shared<Keyframe>();
-  keyframe->id = map_->KeyframePtr()->Id();
-  keyframe->timestamp = map_->KeyframePtr()->Timestamp();
-  keyframe->frame = map_->KeyframePtr();
-  const PyramidLevel& level0 = keyframe->frame->Level(0);
-  keyframe->image = ImageU8(level0.Width(), level0.Height());
-  for (int y = 0; y < level0.Height(); ++y) {
-    for (int x = 0; x < level0.Width(); ++x) {
-      keyframe->image(x, y) = static_cast<std::uint8_t>(std::lround(level0.intensity(x, y)));
-    }
-  }
-  keyframe->depth = FrozenDepth::FromMap(*map_);
-  keyframe->reference = reference_;
+  const std::shared_ptr<Keyframe> keyframe = mapper_.Freeze();
   const bool is_new = !graph_.Contains(keyframe->id);
   graph_.Upsert(keyframe, CurrentKeyframePose());
   result->events.push_back({SystemEvent::Kind::kKeyframeFinished, result_frame_id_, keyframe->id});
@@ -130,31 +111,21 @@ void System::FinishCurrentKeyframe(FrameResult* result) {
 void System::StartKeyframe(const std::shared_ptr<const Frame>& frame, const Sim3d& S_w_kf,
                            InverseDepthMap map, FrameResult* result) {
   CurrentKeyframe next{frame->Id(), std::nullopt, S_w_kf};
-  if (map_) {
+  if (mapper_.HasMap()) {
     // Relative to the keyframe it grew from, before the backend moves that one.
     next.parent = current_.id;
     next.S_parent_kf = CurrentKeyframePose().Inverse() * S_w_kf;
     FinishCurrentKeyframe(result);
-    if (options_.recent_keyframes > 0) {
-      recent_.push_front({std::move(map_), std::move(reference_)});
-      if (static_cast<int>(recent_.size()) > options_.recent_keyframes) recent_.pop_back();
-    }
+    mapper_.Retire();
   }
   current_ = next;
+  mapper_.SetMap(std::move(map));
   CompactOldKeyframes();
-  map_ = std::make_unique<InverseDepthMap>(std::move(map));
-  T_kf_last_ = SE3d();
-  T_prev_last_ = SE3d();
-  frames_in_keyframe_ = 0;
-  RebuildReference();
+  tracker_.StartKeyframe();
   result->events.push_back({SystemEvent::Kind::kKeyframeCreated, frame->Id(), frame->Id()});
 }
 
-void System::CompactOldKeyframes() {
-  std::vector<std::int64_t> keep{current_.id};
-  for (const RecentKeyframe& r : recent_) keep.push_back(r.map->KeyframePtr()->Id());
-  graph_.Compact(keep);
-}
+void System::CompactOldKeyframes() { graph_.Compact(mapper_.LiveKeyframeIds()); }
 
 void System::Record(std::int64_t frame_id, const FrameResult& result) {
   const auto index = static_cast<std::size_t>(frame_id);
@@ -173,9 +144,7 @@ void System::Record(std::int64_t frame_id, const FrameResult& result) {
 
 void System::ClearMap() {
   graph_.Clear();
-  recent_.clear();
-  map_.reset();
-  reference_.reset();
+  mapper_.Clear();
   current_ = CurrentKeyframe{};
 }
 
@@ -200,13 +169,11 @@ FrameResult System::ProcessFrame(const ImageU8& image, double timestamp) {
 }
 
 FrameResult System::Process(const std::shared_ptr<const Frame>& frame, const ImageU8& image) {
-  if (!map_) return StartFirstKeyframe(frame, image);
-  if (options_.initialization == Initialization::kTwoView && bootstrap_) {
-    return ProcessTwoViewOnly(frame, image);
-  }
+  if (start_ == StartState::kNoKeyframe) return StartFirstKeyframe(frame, image);
+  if (start_ == StartState::kTwoViewSearch) return ProcessTwoViewOnly(frame, image);
   FrameResult result;
   TrackingResult tracked = TrackFrame(*frame, &result);
-  if (tracked.status == TrackingStatus::kLost && initialised_at_frame_ >= 0) {
+  if (tracked.status == TrackingStatus::kLost && start_ == StartState::kInitialised) {
     if (auto recovered = TrackRecentKeyframes(*frame, &result)) {
       tracked = std::move(*recovered);
       result.status = tracked.status;
@@ -216,7 +183,7 @@ FrameResult System::Process(const std::shared_ptr<const Frame>& frame, const Ima
       result.events.push_back({SystemEvent::Kind::kRecovered, frame->Id(), current_.id});
     }
   }
-  if (initialised_at_frame_ < 0) {
+  if (start_ != StartState::kInitialised) {
     if (auto handled = ProcessWhileInitialising(frame, image, tracked)) return *handled;
   }
   if (tracked.status != TrackingStatus::kLost) MapFrame(frame, image, tracked, &result);
@@ -225,16 +192,11 @@ FrameResult System::Process(const std::shared_ptr<const Frame>& frame, const Ima
 
 TrackingResult System::TrackFrame(const Frame& frame, FrameResult* result) {
   const auto start = Clock::now();
-  TrackingResult tracked =
-      tracker_.Track(*reference_, frame, MotionHypotheses(T_kf_last_, T_prev_last_), affine_);
+  TrackingResult tracked = tracker_.Track(*mapper_.Reference(), frame);
   result->tracking_ms = MillisecondsSince(start);
   result->status = tracked.status;
   result->stats = tracked.stats;
-  if (tracked.status == TrackingStatus::kLost) return tracked;  // keep the last good state
-  T_prev_last_ = T_kf_last_.Inverse() * tracked.T_kf_frame;
-  T_kf_last_ = tracked.T_kf_frame;
-  affine_ = tracked.affine;
-  ++frames_in_keyframe_;
+  if (tracked.status == TrackingStatus::kLost) return tracked;  // the last good state is kept
   SetPose(result, tracked.T_kf_frame);
   return tracked;
 }
@@ -244,48 +206,47 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& 
   const auto start = Clock::now();
   // Distance relative to the mean depth (mean idepth is 1 after normalisation).
   const double relative_distance =
-      tracked.T_kf_frame.Translation().norm() * map_->MeanSmoothedIdepth();
+      tracked.T_kf_frame.Translation().norm() * mapper_.Map().MeanSmoothedIdepth();
   // While a two-view pair is sought or held the first keyframe stays: the random start it
   // would be compared with, or replaced by, lives in that keyframe.
-  const bool start_pending = bootstrap_ || pending_pair_;
+  const bool start_pending =
+      start_ == StartState::kRandomPairSearch || start_ == StartState::kRandomPairHeld;
   const bool view_degrades = tracked.stats.usage < options_.min_keyframe_usage ||
                              tracked.stats.good_ratio < options_.min_keyframe_good_ratio;
-  const bool want_keyframe = !start_pending &&
-                             frames_in_keyframe_ >= options_.min_frames_per_keyframe &&
-                             (view_degrades || relative_distance > options_.keyframe_distance);
+  const bool want_keyframe =
+      !start_pending && tracker_.State().frames_in_keyframe >= options_.min_frames_per_keyframe &&
+      (view_degrades || relative_distance > options_.keyframe_distance);
   if (tracked.status == TrackingStatus::kOk && relative_distance > options_.min_update_baseline) {
     // Only once initialised: the start's keyframe and its selection stay as they were.
-    const SE3d T_kf_update = initialised_at_frame_ < 0
-                                 ? tracked.T_kf_frame
-                                 : update_direction_.Refine(map_->KeyframePtr()->Id(), image,
-                                                            tracked.T_kf_frame, relative_distance);
-    const StereoFrame stereo{frame.get(), T_kf_update.Inverse(), tracked.affine.Gain(),
-                             tracked.affine.b, static_cast<float>(1.0 - tracked.stats.good_ratio)};
-    depth_filter_.Update(map_.get(), stereo);
+    const bool initialised = start_ == StartState::kInitialised;
+    const SE3d T_kf_update =
+        !initialised ? tracked.T_kf_frame
+                     : mapper_.Direction().Refine(mapper_.KeyframeId(), image, tracked.T_kf_frame,
+                                                  relative_distance);
+    mapper_.Update(*frame, T_kf_update, tracked);
     ++depth_updates_;
-    if (!want_keyframe) RebuildReference();
+    if (!want_keyframe) mapper_.PublishReference();
   }
-  if (initialised_at_frame_ < 0) {
+  if (start_ != StartState::kInitialised) {
     BufferInitialFrame(frame, tracked.T_kf_frame);
     if (depth_updates_ >= options_.initialization_updates || want_keyframe) {
-      if (want_keyframe) RebuildReference();
+      if (want_keyframe) mapper_.PublishReference();
       result->revised = FinishInitialisation();
     }
   }
   if (want_keyframe) {  // ok or poor: a degrading view is the reason to switch
-    InverseDepthMap next = depth_filter_.Propagate(*map_, frame, tracked.T_kf_frame.Inverse(),
-                                                   tracked.affine.Gain(), tracked.affine.b);
-    const float s = depth_filter_.NormalizeScale(&next);
+    auto [next, s] = mapper_.Propagate(frame, tracked);
     // Normalising multiplies idepth by s, so a point's new-keyframe coordinates become
     // p' = p / s; the keyframe-to-world similarity absorbs it: S_w_new = S_w_c * Sim3(s).
     const Sim3d S_w_c = CurrentKeyframePose() * Sim3d(tracked.T_kf_frame);
-    const SE3d velocity(T_prev_last_.Rotation(), T_prev_last_.Translation() / s);
+    const SE3d& last_motion = tracker_.State().T_prev_last;
+    const SE3d velocity(last_motion.Rotation(), last_motion.Translation() / s);
     StartKeyframe(frame, S_w_c * Sim3d(s, SO3d(), Eigen::Vector3d::Zero()), std::move(next),
                   result);
     SetPose(result, SE3d());  // the frame is the new keyframe
-    update_direction_.SetKeyframe(frame->Id(), image);
-    T_prev_last_ = velocity;  // constant-velocity guess for the next frame, new keyframe units
-    affine_ = AffineBrightness{};
+    mapper_.Direction().SetKeyframe(frame->Id(), image);
+    // Constant-velocity guess for the next frame in the new keyframe's units.
+    tracker_.SetState(MotionState{SE3d(), velocity, AffineBrightness{}, 0});
     result->is_keyframe = true;
   }
   result->mapping_ms = MillisecondsSince(start);
@@ -293,49 +254,35 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& 
 
 std::optional<TrackingResult> System::TrackRecentKeyframes(const Frame& frame,
                                                            FrameResult* result) {
-  const Sim3d S_w_last = CurrentKeyframePose() * Sim3d(T_kf_last_);
-  for (auto it = recent_.begin(); it != recent_.end(); ++it) {
-    // Two starts, each tracked on its own (the tracker would prefer a start that sees few
-    // points with small residuals): the last pose carried over through the similarities,
-    // and the keyframe's own pose (the camera came back to where it was taken).
-    const std::int64_t id = it->map->KeyframePtr()->Id();
-    TrackingResult r =
-        tracker_.Track(*it->reference, frame, {(graph_.Pose(id).Inverse() * S_w_last).RigidPart()},
-                       AffineBrightness{});
-    if (r.status != TrackingStatus::kOk) {
-      r = tracker_.Track(*it->reference, frame, {SE3d()}, AffineBrightness{});
-    }
-    if (r.status != TrackingStatus::kOk) continue;
-    // The found keyframe becomes current again (its depth is refined further and frozen
-    // again when it is left); the current one is finished and takes its place among the
-    // recent ones.
-    FinishCurrentKeyframe(result);
-    std::swap(map_, it->map);
-    std::swap(reference_, it->reference);
-    std::rotate(recent_.begin(), it, std::next(it));
-    current_ = CurrentKeyframe{id, std::nullopt, Sim3d()};
-    CompactOldKeyframes();
-    update_direction_.Reset();  // its features are of the keyframe left behind
-    T_kf_last_ = r.T_kf_frame;
-    T_prev_last_ = SE3d();
-    affine_ = r.affine;
-    frames_in_keyframe_ = 1;
-    return r;
+  std::vector<RecoveryCandidate> candidates;
+  for (std::size_t i = 0; i < mapper_.NumRecent(); ++i) {
+    candidates.push_back({&mapper_.RecentReference(i), graph_.Pose(mapper_.RecentKeyframeId(i))});
   }
-  return std::nullopt;
+  const Sim3d S_w_last = CurrentKeyframePose() * Sim3d(tracker_.State().T_kf_last);
+  auto found = tracker_.Recover(candidates, frame, S_w_last);
+  if (!found) return std::nullopt;
+  // The found keyframe becomes current again (its depth is refined further and frozen again
+  // when it is left); the current one is finished and takes its place among the recent ones.
+  const std::int64_t id = mapper_.RecentKeyframeId(found->first);
+  FinishCurrentKeyframe(result);
+  mapper_.ReturnTo(found->first);
+  current_ = CurrentKeyframe{id, std::nullopt, Sim3d()};
+  CompactOldKeyframes();
+  return std::move(found->second);
 }
 
 std::vector<Eigen::Vector3f> System::MapPoints() const {
   std::vector<Eigen::Vector3f> all = graph_.MapPoints(camera_);
-  if (map_ && !graph_.Contains(current_.id)) {
+  if (mapper_.HasMap() && !graph_.Contains(current_.id)) {
     // The current keyframe's confirmed points, through its current pose.
+    const InverseDepthMap& map = mapper_.Map();
     const Sim3d S_w_kf = CurrentKeyframePose();
-    const PinholeCamera& K = map_->Keyframe().Camera(0);
-    for (int y = 0; y < map_->Height(); ++y) {
-      for (int x = 0; x < map_->Width(); ++x) {
-        const std::size_t i = map_->Index(x, y);
-        if (!map_->IsConfirmed(i)) continue;
-        const Eigen::Vector3d p = K.Unproject(Eigen::Vector2d(x, y)) / map_->idepth_smoothed[i];
+    const PinholeCamera& K = map.Keyframe().Camera(0);
+    for (int y = 0; y < map.Height(); ++y) {
+      for (int x = 0; x < map.Width(); ++x) {
+        const std::size_t i = map.Index(x, y);
+        if (!map.IsConfirmed(i)) continue;
+        const Eigen::Vector3d p = K.Unproject(Eigen::Vector2d(x, y)) / map.idepth_smoothed[i];
         all.push_back((S_w_kf * p).cast<float>());
       }
     }
@@ -348,8 +295,9 @@ std::vector<KeyframeRecord> System::Keyframes() const {
   for (const std::int64_t id : graph_.Ids()) {
     records.push_back({id, graph_.Get(id).timestamp, graph_.Pose(id)});
   }
-  if (map_ && !graph_.Contains(current_.id)) {
-    records.push_back({current_.id, map_->KeyframePtr()->Timestamp(), CurrentKeyframePose()});
+  if (mapper_.HasMap() && !graph_.Contains(current_.id)) {
+    records.push_back(
+        {current_.id, mapper_.Map().KeyframePtr()->Timestamp(), CurrentKeyframePose()});
   }
   return records;
 }

@@ -8,8 +8,10 @@
 #include <optional>
 #include <vector>
 
+#include "backend/frame_tracker.hpp"
 #include "backend/graph_backend.hpp"
 #include "backend/keyframe_graph.hpp"
+#include "backend/mapper.hpp"
 #include "backend/two_view_bootstrap.hpp"
 #include "backend/update_direction.hpp"
 #include "core/frame.hpp"
@@ -201,7 +203,6 @@ class System {
   void ClearMap();
   /// Keyframes other than the current and the recent ones drop their frame and reference.
   void CompactOldKeyframes();
-  void RebuildReference();
   /// Tries the recent keyframes for a frame lost against the current one (see
   /// SystemOptions::recent_keyframes); on success the found keyframe is current again.
   std::optional<TrackingResult> TrackRecentKeyframes(const Frame& frame, FrameResult* result);
@@ -249,16 +250,27 @@ class System {
 
   PinholeCamera camera_;
   SystemOptions options_;
-  Se3Tracker tracker_;
-  DepthFilter depth_filter_;
-  UpdateDirection update_direction_;
+  /// Where the start of the sequence stands (docs/architecture.md, "The start"):
+  ///   kNoKeyframe --texture--> kTwoViewSearch (two_view) | kRandomPairSearch (auto) |
+  ///   kConverging (random); kTwoViewSearch --pair--> kConverging, --gave up--> kConverging
+  ///   (random depth); kRandomPairSearch --pair--> kRandomPairHeld, --gave up--> kConverging;
+  ///   kRandomPairHeld --lost: start from the pair--> kConverging; any of them --enough depth
+  ///   updates or a keyframe--> kInitialised; --too long lost--> kNoKeyframe (restart).
+  enum class StartState {
+    kNoKeyframe,        ///< waiting for a frame with enough texture
+    kTwoViewSearch,     ///< two_view: keyframe with an empty map, frames only feed the search
+    kRandomPairSearch,  ///< auto: random depth tracks while a two-view pair is sought
+    kRandomPairHeld,    ///< auto: a pair is held until the random start converges or fails
+    kConverging,        ///< the first keyframe's depth converges; no pair work left
+    kInitialised,
+  };
+  StartState start_ = StartState::kNoKeyframe;
+  FrameTracker tracker_;
+  Mapper mapper_;
   GraphBackend backend_;
   BackendStats backend_stats_;
   /// Finished keyframes and their poses (the map).
   KeyframeGraph graph_;
-  /// The current keyframe's mutable depth and its published tracking reference.
-  std::unique_ptr<InverseDepthMap> map_;
-  std::shared_ptr<const TrackingReference> reference_;
   /// Where the current keyframe is: in the graph (returned to), or relative to its parent
   /// until it is finished (or, for the first keyframe, in the world).
   struct CurrentKeyframe {
@@ -267,21 +279,10 @@ class System {
     Sim3d S_parent_kf;  ///< S_w_kf when there is no parent
   };
   CurrentKeyframe current_;
-  /// Mutable depth of the most recent finished keyframes, for recovery (their poses and
-  /// frozen depth are in the graph).
-  struct RecentKeyframe {
-    std::unique_ptr<InverseDepthMap> map;
-    std::shared_ptr<const TrackingReference> reference;
-  };
-  std::deque<RecentKeyframe> recent_;  ///< newest first
   /// Per frame (index = frame id): its anchored pose, if it has one, and its timestamp.
   std::vector<std::optional<AnchoredPose>> frame_poses_;
   std::vector<double> frame_timestamps_;
   std::int64_t result_frame_id_ = 0;  ///< the frame being processed (for events)
-  SE3d T_kf_last_;
-  SE3d T_prev_last_;  ///< last inter-frame motion (for the constant-velocity guess)
-  AffineBrightness affine_;
-  int frames_in_keyframe_ = 0;
   int frame_count_ = 0;
   int depth_updates_ = 0;
   int initialised_at_frame_ = -1;

@@ -23,6 +23,7 @@ FrameResult System::StartFirstKeyframe(const std::shared_ptr<const Frame>& frame
     bootstrap_ = std::make_unique<TwoViewBootstrap>(camera_, options_.bootstrap);
     bootstrap_->SetReference(image);
     bootstrap_tries_ = 0;
+    start_ = StartState::kTwoViewSearch;
   } else {
     StartRandom(frame, image, std::move(map), &result);
   }
@@ -40,10 +41,12 @@ void System::StartRandom(const std::shared_ptr<const Frame>& frame, const ImageU
   depth_updates_ = 0;
   lost_in_a_row_ = 0;
   bootstrap_.reset();
+  start_ = StartState::kConverging;
   if (options_.initialization == Initialization::kAuto) {
     bootstrap_ = std::make_unique<TwoViewBootstrap>(camera_, options_.bootstrap);
     bootstrap_->SetReference(image);
     bootstrap_tries_ = 0;
+    start_ = StartState::kRandomPairSearch;
   }
 }
 
@@ -57,7 +60,8 @@ void System::BufferInitialFrame(const std::shared_ptr<const Frame>& frame, const
 }
 
 std::optional<SE3d> System::TrackAgain(const Frame& frame, const SE3d& guess) {
-  const TrackingResult again = tracker_.Track(*reference_, frame, {guess}, affine_);
+  const TrackingResult again =
+      tracker_.TrackFrom(*mapper_.Reference(), frame, guess, tracker_.State().affine);
   if (again.status == TrackingStatus::kLost) return std::nullopt;
   return again.T_kf_frame;
 }
@@ -66,7 +70,7 @@ std::vector<RevisedPose> System::FinishInitialisation() {
   std::vector<RevisedPose> revised;
   bool replaced = false;
   std::optional<BufferedPoses> poses;  // the buffered frames tracked against the final map
-  if (pending_pair_) {
+  if (start_ == StartState::kRandomPairHeld) {
     // The converged random start must agree with the independent two-view geometry, and
     // then explain the frames at least as well as a start from the pair does.
     const auto& [pair_frame, pair] = *pending_pair_;
@@ -96,6 +100,7 @@ std::vector<RevisedPose> System::FinishInitialisation() {
   }
   initial_frames_.clear();
   bootstrap_.reset();
+  start_ = StartState::kInitialised;
   initialised_at_frame_ = frame_count_ - 1;
   return revised;
 }
@@ -125,12 +130,14 @@ FrameResult System::ProcessTwoViewOnly(const std::shared_ptr<const Frame>& frame
 std::optional<FrameResult> System::ProcessWhileInitialising(
     const std::shared_ptr<const Frame>& frame, const ImageU8& image,
     const TrackingResult& tracked) {
-  if (bootstrap_ && !pending_pair_) {
+  if (start_ == StartState::kRandomPairSearch) {
     if (const auto pair = bootstrap_->TryFrame(image)) {
       pending_pair_.emplace(frame, *pair);
       bootstrap_.reset();
+      start_ = StartState::kRandomPairHeld;
     } else if (++bootstrap_tries_ >= options_.bootstrap_max_frames) {
       bootstrap_.reset();
+      start_ = StartState::kConverging;
     }
   }
   if (tracked.status == TrackingStatus::kOk) {
@@ -139,9 +146,9 @@ std::optional<FrameResult> System::ProcessWhileInitialising(
   }
   FrameResult result;
   result.stats = tracked.stats;
-  if (pending_pair_) {
+  if (start_ == StartState::kRandomPairHeld) {
     // The random start is failing and a pair is at hand: start from the pair now.
-    BufferInitialFrame(frame, T_kf_last_);
+    BufferInitialFrame(frame, tracker_.State().T_kf_last);
     result.revised = StartFromPair(pending_pair_->first, pending_pair_->second);
     pending_pair_.reset();
     TakeNewestRevision(&result);
@@ -150,17 +157,18 @@ std::optional<FrameResult> System::ProcessWhileInitialising(
   if (tracked.status == TrackingStatus::kPoor) return std::nullopt;
   result.status = TrackingStatus::kLost;
   // Lost frames wait for a pair while one is sought; then a restart is the way out.
-  if (bootstrap_ || ++lost_in_a_row_ < options_.restart_after_lost) {
-    BufferInitialFrame(frame, T_kf_last_);  // tried again when initialised
+  if (start_ == StartState::kRandomPairSearch || ++lost_in_a_row_ < options_.restart_after_lost) {
+    BufferInitialFrame(frame, tracker_.State().T_kf_last);  // tried again when initialised
     return result;
   }
   // The start has failed: withdraw every pose given so far and start again here.
-  result.revised.push_back(Revised(*map_->KeyframePtr(), std::nullopt));
+  result.revised.push_back(Revised(*mapper_.Map().KeyframePtr(), std::nullopt));
   for (const auto& buffered : initial_frames_) {
     result.revised.push_back(Revised(*buffered.first, std::nullopt));
   }
   initial_frames_.clear();
   ClearMap();
+  start_ = StartState::kNoKeyframe;
   FrameResult restarted = StartFirstKeyframe(frame, image);
   restarted.revised = std::move(result.revised);
   restarted.events.insert(restarted.events.begin(),
@@ -188,12 +196,13 @@ std::vector<RevisedPose> System::StartFromPair(const std::shared_ptr<const Frame
                                                const TwoViewPair& pair) {
   // Stereo with the pair's pose creates the keyframe's depth from scratch (full-range
   // searches); the scale is normalised and the frames seen so far are tracked against it.
-  map_ = std::make_unique<InverseDepthMap>(map_->KeyframePtr(), options_.depth);
-  depth_filter_.Update(
-      map_.get(), StereoFrame{pair_frame.get(), pair.T_frame_ref, pair.gain, pair.offset, 0.0f});
-  const float s = depth_filter_.NormalizeScale(map_.get());
-  RebuildReference();
+  InverseDepthMap map(mapper_.Map().KeyframePtr(), options_.depth);
+  mapper_.Filter().Update(
+      &map, StereoFrame{pair_frame.get(), pair.T_frame_ref, pair.gain, pair.offset, 0.0f});
+  const float s = mapper_.Filter().NormalizeScale(&map);
+  mapper_.SetMap(std::move(map));
   bootstrap_.reset();
+  start_ = StartState::kConverging;  // pending_pair_ is the caller's to drop
   depth_updates_ = 1;
   lost_in_a_row_ = 0;
   // Normalisation multiplied inverse depths by s: lengths in keyframe units scale by 1/s.
@@ -203,23 +212,22 @@ std::vector<RevisedPose> System::StartFromPair(const std::shared_ptr<const Frame
   auto buffered = std::move(initial_frames_);
   initial_frames_.clear();
   SE3d guess, previous;
-  affine_ = AffineBrightness{};
+  AffineBrightness affine;
   for (const auto& [frame, unused] : buffered) {
     if (frame == pair_frame) guess = T_kf_pair_frame;
-    const TrackingResult r = tracker_.Track(*reference_, *frame, {guess}, affine_);
+    const TrackingResult r = tracker_.TrackFrom(*mapper_.Reference(), *frame, guess, affine);
     std::optional<SE3d> pose;
     if (r.status != TrackingStatus::kLost) {
       previous = guess;
       guess = r.T_kf_frame;
-      affine_ = r.affine;
+      affine = r.affine;
       pose = r.T_kf_frame;
     }
     initial_frames_.emplace_back(frame, guess);
     revised.push_back(Revised(*frame, pose));
   }
-  T_prev_last_ = previous.Inverse() * guess;
-  T_kf_last_ = guess;
-  frames_in_keyframe_ = static_cast<int>(buffered.size());
+  tracker_.SetState(
+      MotionState{guess, previous.Inverse() * guess, affine, static_cast<int>(buffered.size())});
   return revised;
 }
 

@@ -1,0 +1,47 @@
+#include "backend/frame_tracker.hpp"
+
+namespace parallax {
+
+FrameTracker::FrameTracker(const Se3TrackerOptions& options) : tracker_(options) {}
+
+TrackingResult FrameTracker::Track(const TrackingReference& reference, const Frame& frame) {
+  TrackingResult tracked = tracker_.Track(
+      reference, frame, MotionHypotheses(state_.T_kf_last, state_.T_prev_last), state_.affine);
+  if (tracked.status == TrackingStatus::kLost) return tracked;
+  state_.T_prev_last = state_.T_kf_last.Inverse() * tracked.T_kf_frame;
+  state_.T_kf_last = tracked.T_kf_frame;
+  state_.affine = tracked.affine;
+  ++state_.frames_in_keyframe;
+  return tracked;
+}
+
+TrackingResult FrameTracker::TrackFrom(const TrackingReference& reference, const Frame& frame,
+                                       const SE3d& guess, const AffineBrightness& affine) {
+  return tracker_.Track(reference, frame, {guess}, affine);
+}
+
+std::optional<std::pair<std::size_t, TrackingResult>> FrameTracker::Recover(
+    const std::vector<RecoveryCandidate>& candidates, const Frame& frame, const Sim3d& S_w_last) {
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    const RecoveryCandidate& c = candidates[k];
+    // Two starts, each tracked on its own (the tracker would prefer a start that sees few
+    // points with small residuals): the last pose carried over through the similarities,
+    // and the keyframe's own pose (the camera came back to where it was taken).
+    TrackingResult r = tracker_.Track(
+        *c.reference, frame, {(c.S_w_kf.Inverse() * S_w_last).RigidPart()}, AffineBrightness{});
+    if (r.status != TrackingStatus::kOk) {
+      r = tracker_.Track(*c.reference, frame, {SE3d()}, AffineBrightness{});
+    }
+    if (r.status != TrackingStatus::kOk) continue;
+    state_ = MotionState{r.T_kf_frame, SE3d(), r.affine, 1};
+    return std::make_pair(k, std::move(r));
+  }
+  return std::nullopt;
+}
+
+void FrameTracker::StartKeyframe() {
+  // The brightness estimate carries over: the same camera sees the same scene.
+  state_ = MotionState{SE3d(), SE3d(), state_.affine, 0};
+}
+
+}  // namespace parallax

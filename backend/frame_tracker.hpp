@@ -1,0 +1,58 @@
+#pragma once
+// The tracking stage: a frame against the current keyframe's published reference, with the
+// constant-velocity motion hypotheses; recovery on recent keyframes. Never touches depth.
+
+#include <cstddef>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "core/frame.hpp"
+#include "core/se3.hpp"
+#include "core/sim3.hpp"
+#include "tracking/se3_tracker.hpp"
+#include "tracking/tracking_reference.hpp"
+
+namespace parallax {
+
+/// What the tracker carries from frame to frame within one keyframe.
+struct MotionState {
+  SE3d T_kf_last;    ///< pose of the last tracked frame in the keyframe
+  SE3d T_prev_last;  ///< last inter-frame motion (for the constant-velocity guess)
+  AffineBrightness affine;
+  int frames_in_keyframe = 0;
+};
+
+/// A keyframe to try when tracking is lost on the current one.
+struct RecoveryCandidate {
+  const TrackingReference* reference = nullptr;
+  Sim3d S_w_kf;
+};
+
+class FrameTracker {
+ public:
+  explicit FrameTracker(const Se3TrackerOptions& options);
+
+  /// Tracks `frame` on `reference` from the motion hypotheses; a frame that is not lost
+  /// advances the motion state (a lost one keeps the last good state).
+  TrackingResult Track(const TrackingReference& reference, const Frame& frame);
+  /// One start, no state change (frames tracked again during initialisation).
+  TrackingResult TrackFrom(const TrackingReference& reference, const Frame& frame,
+                           const SE3d& guess, const AffineBrightness& affine);
+  /// Tries the candidates in order, each from the last pose carried over through the
+  /// similarities (S_w_last: the last tracked frame's world similarity) and then from the
+  /// keyframe's own pose; the first that tracks "ok" restarts the motion state on it.
+  std::optional<std::pair<std::size_t, TrackingResult>> Recover(
+      const std::vector<RecoveryCandidate>& candidates, const Frame& frame, const Sim3d& S_w_last);
+
+  /// A new keyframe: pose and velocity restart at identity, no frame tracked in it yet.
+  void StartKeyframe();
+  const MotionState& State() const { return state_; }
+  void SetState(const MotionState& state) { state_ = state; }
+
+ private:
+  Se3Tracker tracker_;
+  MotionState state_;
+};
+
+}  // namespace parallax

@@ -1,0 +1,103 @@
+#include "backend/mapper.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "depth/depth_map.hpp"
+
+namespace parallax {
+
+Mapper::Mapper(const PinholeCamera& camera, const DepthFilterOptions& depth,
+               const UpdateDirectionOptions& update_direction,
+               const TrackingReferenceOptions& reference, int recent_keyframes)
+    : depth_filter_(depth),
+      update_direction_(camera, update_direction),
+      reference_options_(reference),
+      recent_keyframes_(recent_keyframes) {}
+
+std::int64_t Mapper::KeyframeId() const { return map_->KeyframePtr()->Id(); }
+
+std::int64_t Mapper::RecentKeyframeId(std::size_t i) const {
+  return recent_[i].map->KeyframePtr()->Id();
+}
+
+void Mapper::SetMap(InverseDepthMap map) {
+  map_ = std::make_unique<InverseDepthMap>(std::move(map));
+  PublishReference();
+}
+
+void Mapper::Restore(std::unique_ptr<InverseDepthMap> map,
+                     std::shared_ptr<const TrackingReference> reference) {
+  map_ = std::move(map);
+  reference_ = std::move(reference);
+}
+
+void Mapper::PublishReference() {
+  ImageF idepth, variance;
+  map_->ExportSmoothed(&idepth, &variance);
+  reference_ = std::make_shared<const TrackingReference>(map_->KeyframePtr(), idepth, variance,
+                                                         reference_options_);
+}
+
+void Mapper::Update(const Frame& frame, const SE3d& T_kf_update, const TrackingResult& tracked) {
+  const StereoFrame stereo{&frame, T_kf_update.Inverse(), tracked.affine.Gain(), tracked.affine.b,
+                           static_cast<float>(1.0 - tracked.stats.good_ratio)};
+  depth_filter_.Update(map_.get(), stereo);
+}
+
+std::pair<InverseDepthMap, float> Mapper::Propagate(const std::shared_ptr<const Frame>& frame,
+                                                    const TrackingResult& tracked) const {
+  InverseDepthMap next = depth_filter_.Propagate(*map_, frame, tracked.T_kf_frame.Inverse(),
+                                                 tracked.affine.Gain(), tracked.affine.b);
+  const float s = depth_filter_.NormalizeScale(&next);
+  return {std::move(next), s};
+}
+
+std::shared_ptr<Keyframe> Mapper::Freeze() const {
+  auto keyframe = std::make_shared<Keyframe>();
+  keyframe->id = map_->KeyframePtr()->Id();
+  keyframe->timestamp = map_->KeyframePtr()->Timestamp();
+  keyframe->frame = map_->KeyframePtr();
+  const PyramidLevel& level0 = keyframe->frame->Level(0);
+  keyframe->image = ImageU8(level0.Width(), level0.Height());
+  for (int y = 0; y < level0.Height(); ++y) {
+    for (int x = 0; x < level0.Width(); ++x) {
+      keyframe->image(x, y) = static_cast<std::uint8_t>(std::lround(level0.intensity(x, y)));
+    }
+  }
+  keyframe->depth = FrozenDepth::FromMap(*map_);
+  keyframe->reference = reference_;
+  return keyframe;
+}
+
+void Mapper::Retire() {
+  if (recent_keyframes_ > 0) {
+    recent_.push_front({std::move(map_), std::move(reference_)});
+    if (static_cast<int>(recent_.size()) > recent_keyframes_) recent_.pop_back();
+  }
+  map_.reset();
+  reference_.reset();
+}
+
+void Mapper::ReturnTo(std::size_t i) {
+  const auto it = recent_.begin() + static_cast<std::ptrdiff_t>(i);
+  std::swap(map_, it->map);
+  std::swap(reference_, it->reference);
+  std::rotate(recent_.begin(), it, std::next(it));
+  update_direction_.Reset();  // its features are of the keyframe left behind
+}
+
+std::vector<std::int64_t> Mapper::LiveKeyframeIds() const {
+  std::vector<std::int64_t> ids;
+  if (map_) ids.push_back(KeyframeId());
+  for (const Recent& r : recent_) ids.push_back(r.map->KeyframePtr()->Id());
+  return ids;
+}
+
+void Mapper::Clear() {
+  recent_.clear();
+  map_.reset();
+  reference_.reset();
+}
+
+}  // namespace parallax
