@@ -95,6 +95,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"fallback_odometry_information", Set(&o->backend.fallback_odometry_information)},
         {"odometry_from_alignment", Set(&o->backend.odometry_from_alignment)},
         {"optimizer_max_iterations", Set(&o->backend.optimizer.max_iterations)},
+        {"alignment_finest_level", Set(&o->backend.alignment.finest_level)},
         {"optimizer_kernel_width", Set(&o->backend.optimizer.kernel_width)}}},
   };
 }

@@ -166,6 +166,36 @@ TEST(Motions, OrbitClosesAndRotateHoldsPosition) {
   }
 }
 
+TEST(SynthMotion, PatrolIsContinuousAtWalkingSpeedAndComesBack) {
+  const Scene scene = MakeScene("corridor", 1);
+  const CameraRig& rig = scene.rig;
+  const double lap = (2.0 * rig.patrol_length + 2.0 * M_PI * rig.patrol_radius) / rig.walk_speed;
+  double previous_speed = -1.0;
+  for (double t = 0.0; t < 1.5 * lap; t += 0.01) {
+    const SE3d a = CameraPose(Motion::kPatrol, rig, t, 0.0);
+    const SE3d b = CameraPose(Motion::kPatrol, rig, t + 0.01, 0.0);
+    const double speed = (b.Translation() - a.Translation()).norm() / 0.01;
+    // Walking speed with the sway and bob on top; no jump at the joints of legs and turns.
+    EXPECT_NEAR(speed, rig.walk_speed, 0.3) << "t " << t;
+    EXPECT_LT((a.Rotation().Inverse() * b.Rotation()).Log().norm(),
+              0.01 * rig.walk_speed / rig.patrol_radius + 0.01)
+        << "t " << t;
+    previous_speed = speed;
+  }
+  EXPECT_GT(previous_speed, 0.0);
+  // Half a lap later it walks the other way, 2r to the side; a lap later it is back.
+  const SE3d start = CameraPose(Motion::kPatrol, rig, 0.0, 0.0);
+  const SE3d back = CameraPose(Motion::kPatrol, rig, lap, 0.0);
+  const SE3d half = CameraPose(Motion::kPatrol, rig, 0.5 * lap, 0.0);
+  EXPECT_LT((back.Translation() - start.Translation()).norm(), 0.1);
+  EXPECT_LT((back.Rotation().Inverse() * start.Rotation()).Log().norm(), 0.1);
+  const Eigen::Vector3d axis_start = start.Rotation() * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d axis_half = half.Rotation() * Eigen::Vector3d::UnitZ();
+  EXPECT_LT(axis_start.dot(axis_half), -0.9);
+  EXPECT_NEAR((half.Translation() - start.Translation()).dot(rig.walk_direction), rig.patrol_length,
+              0.2);
+}
+
 TEST(SynthSequence, TumReaderAcceptsOutputWithoutFlags) {
   test::TempDir dir;
   SynthOptions options;

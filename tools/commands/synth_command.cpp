@@ -18,7 +18,7 @@ void AddSynthCommand(CLI::App& app, int* exit_code) {
       ->required()
       ->check(CLI::IsMember(synth::SceneNames()));
   cmd->add_option("out-dir", *out_dir, "output folder (created)")->required();
-  cmd->add_option("--motion", options->motion, "shake | walk | orbit | rotate | fast")
+  cmd->add_option("--motion", options->motion, "shake | walk | orbit | rotate | fast | patrol")
       ->check(CLI::IsMember(synth::MotionNames()));
   cmd->add_option("--frames", options->frames, "number of frames")->check(CLI::Range(2, 100000));
   cmd->add_option("--seed", options->seed, "random seed (textures, noise)");

@@ -33,6 +33,39 @@ SE3d Walk(const CameraRig& rig, double t) {
   return SE3d(LookAt(position, target), position);
 }
 
+// A racetrack centred on the start line: leg out at -r sideways, U-turn, leg back at +r,
+// U-turn; the camera looks 3 m ahead along the direction of travel, with the walk's sway.
+SE3d Patrol(const CameraRig& rig, double t) {
+  const Vector3d f = rig.walk_direction.normalized();
+  const Vector3d side = Vector3d(0, 1, 0).cross(f).normalized();
+  const double L = rig.patrol_length;
+  const double r = rig.patrol_radius;
+  const double half_turn = std::numbers::pi * r;
+  const double s = std::fmod(rig.walk_speed * t, 2.0 * L + 2.0 * half_turn);
+  const Vector3d origin = rig.start - r * side;
+  Vector3d position, heading;
+  if (s < L) {
+    position = origin + s * f;
+    heading = f;
+  } else if (s < L + half_turn) {
+    const double a = (s - L) / r;
+    position = origin + L * f + r * side + r * (-std::cos(a) * side + std::sin(a) * f);
+    heading = std::sin(a) * side + std::cos(a) * f;
+  } else if (s < 2.0 * L + half_turn) {
+    position = origin + (2.0 * L + half_turn - s) * f + 2.0 * r * side;
+    heading = -f;
+  } else {
+    const double a = (s - 2.0 * L - half_turn) / r;
+    position = origin + r * side + r * (std::cos(a) * side - std::sin(a) * f);
+    heading = -std::sin(a) * side - std::cos(a) * f;
+  }
+  const Vector3d across = Vector3d(0, 1, 0).cross(heading).normalized();
+  position += 0.03 * std::sin(kTwoPi * 0.9 * t) * across +
+              Vector3d(0, 0.02 * std::sin(kTwoPi * 1.8 * t), 0);
+  const Vector3d target = position + 3.0 * heading + 0.1 * std::sin(kTwoPi * 0.3 * t) * across;
+  return SE3d(LookAt(position, target), position);
+}
+
 SE3d Orbit(const CameraRig& rig, double t, double duration) {
   const double phi = duration > 0.0 ? kTwoPi * t / duration : 0.0;
   const Vector3d position(rig.orbit_centre.x() + rig.orbit_radius * std::sin(phi), rig.start.y(),
@@ -56,7 +89,9 @@ SE3d Rotate(const CameraRig& rig, double t, double duration) {
 
 }  // namespace
 
-std::vector<std::string> MotionNames() { return {"shake", "walk", "orbit", "rotate", "fast"}; }
+std::vector<std::string> MotionNames() {
+  return {"shake", "walk", "orbit", "rotate", "fast", "patrol"};
+}
 
 Motion MotionFromString(const std::string& name) {
   if (name == "shake") return Motion::kShake;
@@ -64,8 +99,9 @@ Motion MotionFromString(const std::string& name) {
   if (name == "orbit") return Motion::kOrbit;
   if (name == "rotate") return Motion::kRotate;
   if (name == "fast") return Motion::kFast;
+  if (name == "patrol") return Motion::kPatrol;
   throw std::invalid_argument("unknown motion '" + name +
-                              "' (expected shake, walk, orbit, rotate or fast)");
+                              "' (expected shake, walk, orbit, rotate, fast or patrol)");
 }
 
 SO3d LookAt(const Vector3d& position, const Vector3d& target) {
@@ -91,6 +127,8 @@ SE3d CameraPose(Motion motion, const CameraRig& rig, double t, double duration) 
       return Orbit(rig, t, duration);
     case Motion::kRotate:
       return Rotate(rig, t, duration);
+    case Motion::kPatrol:
+      return Patrol(rig, t);
   }
   return SE3d();
 }

@@ -15,10 +15,11 @@ enum class Motion {
   kOrbit,   ///< full circle around the rig's orbit centre, looking at it; ends where it began
   kRotate,  ///< sideways translation, then pure rotation in place, then translation again
   kFast,    ///< like shake, 2x amplitude and 2.5x frequency
+  kPatrol,  ///< there and back along the walk direction (U-turns at both ends), repeated
 };
 
 std::vector<std::string> MotionNames();
-/// "shake", "walk", "orbit", "rotate", "fast"; throws std::invalid_argument otherwise.
+/// "shake", "walk", "orbit", "rotate", "fast", "patrol"; throws std::invalid_argument otherwise.
 Motion MotionFromString(const std::string& name);
 
 /// Camera-to-world pose at time t in [0, duration] (seconds); continuous in t.

@@ -63,6 +63,8 @@ void BuildDesk(Scene* s) {
   AddBox(s, {-0.8, 0.37, 0.5}, {-0.5, 0.4, 0.75}, kPrintTex, 0.2);     // paper
   AddPanel(s, {-0.9, -0.6, 1.55}, {0.9, 0.3, 1.6}, kPostersTex, 0.8);  // pin board
   s->rig = {{0.0, -0.2, 0.0}, {0.0, 0.3, 0.9}, {0.0, 0.0, 1.0}, 0.3, {0.0, 0.3, 0.9}, 0.6, 0.06};
+  s->rig.patrol_length = 0.4;
+  s->rig.patrol_radius = 0.1;
 }
 
 void BuildCorridor(Scene* s) {
@@ -78,6 +80,8 @@ void BuildCorridor(Scene* s) {
   }
   AddBox(s, {0.5, 0.6, 9.0}, {1.05, 1.3, 9.6}, kBricksTex, 0.8);  // cabinet in the corridor
   s->rig = {{0.0, 0.0, 0.0}, {0.0, 0.0, 6.0}, {0.0, 0.0, 1.0}, 1.2, {0.0, 0.0, 4.0}, 0.5, 0.1};
+  s->rig.patrol_length = 20.0;  // of the 32 m corridor
+  s->rig.patrol_radius = 0.6;   // in its 2.2 m width
 }
 
 void BuildStreet(Scene* s) {
@@ -94,6 +98,8 @@ void BuildStreet(Scene* s) {
     AddBox(s, {x, 0.1, z}, {x + 1.8, 1.5, z + 4.2}, kPostersTex, 2.0);  // parked cars
   }
   s->rig = {{0.0, 0.0, 0.0}, {0.0, 0.0, 20.0}, {0.0, 0.0, 1.0}, 6.0, {0.0, 0.0, 15.0}, 4.0, 0.3};
+  s->rig.patrol_length = 60.0;
+  s->rig.patrol_radius = 3.0;
 }
 
 }  // namespace

@@ -30,6 +30,10 @@ struct CameraRig {
   Eigen::Vector3d orbit_centre;    ///< orbits circle this point in the horizontal plane
   double orbit_radius = 1.0;
   double shake_amplitude = 0.1;  ///< m, hand-held motion
+  /// Patrols: straight legs of this length along walk_direction joined by U-turns of this
+  /// radius (m), walked at walk_speed (set per scene).
+  double patrol_length = 2.0;
+  double patrol_radius = 0.4;
 };
 
 struct Scene {
