@@ -1,5 +1,7 @@
 // The `parallax` command: one executable, one subcommand per user job (docs/cli.md).
 
+#include <malloc.h>
+
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
@@ -30,6 +32,11 @@ int Run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Frame pyramids (several MB) are allocated and freed every frame. glibc raises its mmap
+  // threshold after the first such free, after which they come from the heap and fragment
+  // it, so RSS keeps the peak of the short-lived buffers; a fixed threshold keeps them mapped
+  // and returned when freed (docs/benchmarks.md, "Keyframe graph in the pipeline").
+  mallopt(M_MMAP_THRESHOLD, 1 << 20);
   // Every error reaches the user as one line on stderr and a non-zero exit, never a crash.
   try {
     return Run(argc, argv);

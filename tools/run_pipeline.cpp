@@ -68,6 +68,50 @@ void WriteStats(const std::string& path, const RunSummary& s) {
   out << j.dump(2) << "\n";
 }
 
+std::string EventNames(const std::vector<SystemEvent>& events) {
+  std::string names;
+  for (const SystemEvent& e : events) {
+    if (!names.empty()) names += ';';
+    switch (e.kind) {
+      case SystemEvent::Kind::kKeyframeCreated:
+        names += "keyframe";
+        break;
+      case SystemEvent::Kind::kKeyframeFinished:
+        names += "finished";
+        break;
+      case SystemEvent::Kind::kGraphOptimised:
+        names += "optimised";
+        break;
+      case SystemEvent::Kind::kLost:
+        names += "lost";
+        break;
+      case SystemEvent::Kind::kRecovered:
+        names += "recovered";
+        break;
+      case SystemEvent::Kind::kPosesRevised:
+        names += "revised";
+        break;
+      case SystemEvent::Kind::kRestarted:
+        names += "restarted";
+        break;
+    }
+  }
+  return names;
+}
+
+void WriteTrajectory(const std::filesystem::path& out, const std::string& name,
+                     const Trajectory& trajectory, RunOptions::TrajectoryFormat format) {
+  const std::string path = (out / (name + ".txt")).string();
+  if (format == RunOptions::TrajectoryFormat::kTum) {
+    WriteTumTrajectory(path, trajectory);
+    return;
+  }
+  WriteKittiTrajectory(path, trajectory);
+  std::ofstream times((out / (name + ".times.txt")).string());
+  for (const StampedPose& p : trajectory) times << FormatTimestamp(p.timestamp) << '\n';
+  if (!times) throw InputError((out / (name + ".times.txt")).string(), "write failed");
+}
+
 }  // namespace
 
 RunSummary RunDataset(const RunOptions& options) {
@@ -86,6 +130,11 @@ RunSummary RunDataset(const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   const std::size_t num_frames = reader->NumFrames();  // the reader belongs to `frames` now
   FramePrefetcher frames(reader.get(), &undistorter);
+  const std::string frame_log_path =
+      (std::filesystem::path(options.out_dir) / "frames.csv").string();
+  std::ofstream frame_log(frame_log_path);
+  if (!frame_log) throw InputError(frame_log_path, "cannot open for writing");
+  frame_log << "frame,timestamp,status,posed,keyframe,tracking_ms,mapping_ms,events\n";
   while (options.max_frames == 0 || summary.frames < options.max_frames) {
     const auto frame = frames.Next();
     if (!frame) break;
@@ -93,6 +142,10 @@ RunSummary RunDataset(const RunOptions& options) {
     ++summary.frames;
     summary.frames_tracked += result.T_w_c.has_value();
     if (result.T_w_c) online.push_back(StampedPose{frame->timestamp, *result.T_w_c});
+    frame_log << fmt::format("{},{},{},{},{},{:.3f},{:.3f},{}\n", summary.frames - 1,
+                             FormatTimestamp(frame->timestamp), ToString(result.status),
+                             result.T_w_c ? 1 : 0, result.is_keyframe ? 1 : 0, result.tracking_ms,
+                             result.mapping_ms, EventNames(result.events));
     tracking_ms.push_back(result.tracking_ms);
     mapping_ms.push_back(result.mapping_ms);
     if (options.progress) {
@@ -128,8 +181,9 @@ RunSummary RunDataset(const RunOptions& options) {
   getrusage(RUSAGE_SELF, &usage);
   summary.peak_rss_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;
   const std::filesystem::path out(options.out_dir);
-  WriteTumTrajectory((out / "trajectory.txt").string(), trajectory);
-  WriteTumTrajectory((out / "trajectory_online.txt").string(), online);
+  WriteTrajectory(out, "trajectory", trajectory, options.trajectory_format);
+  WriteTrajectory(out, "trajectory_online", online, options.trajectory_format);
+  if (!frame_log.flush()) throw InputError(frame_log_path, "write failed");
   Trajectory keyframes;
   for (const KeyframeRecord& kf : system.Keyframes()) {
     keyframes.push_back({kf.timestamp, SE3d(kf.S_w_kf.Rotation(), kf.S_w_kf.Translation())});

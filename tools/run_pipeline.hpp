@@ -16,6 +16,10 @@ struct RunOptions {
   int max_frames = 0;  ///< 0: all
   SystemOptions system;
   bool progress = false;  ///< a progress line on stderr
+  /// trajectory*.txt as TUM (timestamp tx ty tz qx qy qz qw) or KITTI (row-major 3x4 per
+  /// posed frame, with the timestamps in trajectory*.times.txt beside it).
+  enum class TrajectoryFormat { kTum, kKitti };
+  TrajectoryFormat trajectory_format = TrajectoryFormat::kTum;
 };
 
 struct RunSummary {
@@ -41,8 +45,9 @@ struct RunSummary {
 
 /// Reads the dataset, rectifies each image, runs System::ProcessFrame, and writes
 /// out_dir/{trajectory.txt (every posed frame through the final, optimised keyframe graph),
-/// trajectory_online.txt (the poses as reported live), keyframes.txt, map.ply, stats.json}. Throws
-/// InputError for bad input (naming the file) and std::invalid_argument for bad options.
+/// trajectory_online.txt (the poses as reported live), keyframes.txt, map.ply, stats.json,
+/// frames.csv (per frame: status, whether posed, keyframe, tracking and mapping ms, events)}.
+/// Throws InputError for bad input (naming the file) and std::invalid_argument for bad options.
 RunSummary RunDataset(const RunOptions& options);
 
 }  // namespace parallax

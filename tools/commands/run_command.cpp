@@ -27,10 +27,17 @@ void AddRunCommand(CLI::App& app, int* exit_code) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--config", *config, "pipeline options, YAML (docs/configuration.md)");
   cmd->add_flag("--realtime", *realtime, "threaded real-time mode (not implemented yet)");
+  auto trajectory_format = std::make_shared<std::string>("tum");
+  cmd->add_option("--trajectory-format", *trajectory_format,
+                  "trajectory files as tum, or kitti (+ <name>.times.txt)")
+      ->check(CLI::IsMember({"tum", "kitti"}));
   // Accepted so that scripts written against design.md section 5 run today: there is no loop
   // closure yet, so every run already is one without it.
   cmd->add_flag("--no-loop-closure")->description("disable loop closure (no effect yet)");
-  cmd->callback([options, format, realtime, config, exit_code] {
+  cmd->callback([options, format, realtime, config, trajectory_format, exit_code] {
+    options->trajectory_format = *trajectory_format == "kitti"
+                                     ? RunOptions::TrajectoryFormat::kKitti
+                                     : RunOptions::TrajectoryFormat::kTum;
     if (*realtime)
       throw std::invalid_argument("--realtime is not implemented yet; the deterministic mode runs");
     if (!config->empty()) ApplyConfigYaml(*config, &options->system);

@@ -57,6 +57,8 @@ class DatasetReader {
   /// InputError if the file exists but is malformed.
   virtual std::optional<Trajectory> GroundTruth() const { return std::nullopt; }
   virtual std::optional<PhotometricCalibration> Photometric() const { return std::nullopt; }
+  /// Timestamps of every image (seconds), without reading them; empty where unknown (video).
+  virtual std::vector<double> FrameTimestamps() const { return {}; }
 };
 
 struct DatasetOptions {

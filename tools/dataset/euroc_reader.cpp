@@ -9,6 +9,7 @@
 
 #include "tools/dataset/calibration_yaml.hpp"
 #include "tools/dataset/file_list_reader.hpp"
+#include "tools/dataset/groundtruth_files.hpp"
 #include "tools/dataset/input_error.hpp"
 #include "tools/dataset/text_lines.hpp"
 
@@ -86,6 +87,10 @@ Trajectory ReadEurocGroundTruth(const std::string& file, const SE3d& T_B_S) {
 }
 
 }  // namespace
+
+Trajectory ReadEurocGroundTruthFile(const std::string& data_csv, const std::string& sensor_yaml) {
+  return ReadEurocGroundTruth(data_csv, ReadSensorYaml(sensor_yaml).T_B_S);
+}
 
 std::unique_ptr<DatasetReader> OpenEuroc(const std::string& path, const std::string& calibration) {
   const fs::path mav0 = Mav0(path);

@@ -58,6 +58,13 @@ std::optional<DatasetFrame> FileListReader::Next() {
   return frame;
 }
 
+std::vector<double> FileListReader::FrameTimestamps() const {
+  std::vector<double> stamps;
+  stamps.reserve(spec_.entries.size());
+  for (const ImageEntry& e : spec_.entries) stamps.push_back(e.timestamp);
+  return stamps;
+}
+
 std::optional<Trajectory> FileListReader::GroundTruth() const {
   if (!spec_.groundtruth) return std::nullopt;
   return spec_.groundtruth();

@@ -46,6 +46,7 @@ class FileListReader final : public DatasetReader {
   std::optional<DatasetFrame> Next() override;
   std::optional<Trajectory> GroundTruth() const override;
   std::optional<PhotometricCalibration> Photometric() const override { return spec_.photometric; }
+  std::vector<double> FrameTimestamps() const override;
 
  private:
   FileListSpec spec_;

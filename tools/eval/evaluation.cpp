@@ -65,6 +65,8 @@ void EvaluationOptions::Check() const {
   CheckOption(std::isfinite(max_dt) && max_dt > 0.0, "EvaluationOptions", "max_dt", "must be > 0");
   CheckOption(std::isfinite(rpe_delta_seconds) && rpe_delta_seconds > 0.0, "EvaluationOptions",
               "rpe_delta_seconds", "must be > 0");
+  CheckOption(std::isfinite(rpe_delta_meters) && rpe_delta_meters >= 0.0, "EvaluationOptions",
+              "rpe_delta_meters", "must be >= 0");
 }
 
 ErrorStatistics ComputeStatistics(std::vector<double> errors) {
@@ -109,6 +111,14 @@ EvaluationReport Evaluate(const Trajectory& estimate, const Trajectory& groundtr
   }
   report.coverage = static_cast<double>(report.matched) /
                     static_cast<double>(std::max<std::size_t>(report.groundtruth_in_span, 1));
+  if (!options.frame_timestamps.empty()) {
+    report.frames = options.frame_timestamps.size();
+    Trajectory frames;
+    for (const double t : options.frame_timestamps) frames.push_back({t, SE3d()});
+    report.frames_with_pose = AssociateByTimestamp(estimate, frames, options.max_dt).size();
+    report.coverage =
+        static_cast<double>(report.frames_with_pose) / static_cast<double>(report.frames);
+  }
   std::vector<Eigen::Vector3d> x, y;
   std::vector<SO3d> R_x, R_y;  // settle the turn about the line of a straight trajectory
   for (const auto& p : pairs) {
@@ -145,6 +155,22 @@ EvaluationReport Evaluate(const Trajectory& estimate, const Trajectory& groundtr
   }
   report.rpe_per_frame = ComputeRpe(est, gt, per_frame);
   report.rpe_per_second = ComputeRpe(est, gt, per_second);
+  report.rpe_delta_meters = options.rpe_delta_meters > 0.0 ? options.rpe_delta_meters
+                                                           : report.groundtruth_path_length / 10.0;
+  if (report.rpe_delta_meters > 0.0) {
+    std::vector<double> along(gt.size(), 0.0);
+    for (std::size_t i = 1; i < gt.size(); ++i) {
+      along[i] = along[i - 1] + (gt[i].Translation() - gt[i - 1].Translation()).norm();
+    }
+    std::vector<std::pair<std::size_t, std::size_t>> per_distance;
+    for (std::size_t i = 0, j = 0; i < est.size(); ++i) {
+      j = std::max(j, i + 1);
+      while (j < est.size() && along[j] - along[i] < report.rpe_delta_meters) ++j;
+      if (j >= est.size()) break;
+      per_distance.emplace_back(i, j);
+    }
+    report.rpe_per_distance = ComputeRpe(est, gt, per_distance);
+  }
   report.kitti = ComputeKittiErrors(est, gt);
   return report;
 }
@@ -165,6 +191,11 @@ std::string FormatReport(const EvaluationReport& r) {
   };
   rpe("RPE/frame   ", r.rpe_per_frame);
   rpe("RPE/second  ", r.rpe_per_second);
+  rpe(fmt::format("RPE/{:.3g} m", r.rpe_delta_meters).c_str(), r.rpe_per_distance);
+  if (r.frames > 0) {
+    s += fmt::format("frames       {} of {} image frames have a pose\n", r.frames_with_pose,
+                     r.frames);
+  }
   if (r.kitti.empty()) {
     s += "KITTI        path shorter than 100: no segment errors\n";
   }
@@ -197,6 +228,9 @@ std::string ReportToJson(const EvaluationReport& r) {
                             {"matched", r.matched},
                             {"groundtruth_in_span", r.groundtruth_in_span},
                             {"coverage", r.coverage},
+                            {"coverage_of", r.frames > 0 ? "image frames" : "ground truth"},
+                            {"frames", r.frames},
+                            {"frames_with_pose", r.frames_with_pose},
                             {"ate", stats(r.ate)},
                             {"groundtruth_path_length", r.groundtruth_path_length},
                             {"ate_rmse_percent_of_path", r.ate_rmse_percent_of_path},
@@ -206,6 +240,10 @@ std::string ReportToJson(const EvaluationReport& r) {
                             {"rpe_per_second",
                              {{"translation", stats(r.rpe_per_second.translation)},
                               {"rotation_deg", stats(r.rpe_per_second.rotation_deg)}}},
+                            {"rpe_per_distance",
+                             {{"delta", r.rpe_delta_meters},
+                              {"translation", stats(r.rpe_per_distance.translation)},
+                              {"rotation_deg", stats(r.rpe_per_distance.rotation_deg)}}},
                             {"kitti_segments", kitti}};
   return j.dump(2);
 }

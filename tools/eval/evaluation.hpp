@@ -16,6 +16,13 @@ struct EvaluationOptions {
   double max_dt = 0.02;
   /// Time step of the per-second RPE, seconds.
   double rpe_delta_seconds = 1.0;
+  /// Path length step of the per-distance RPE (ground-truth units); 0: a tenth of the
+  /// matched ground-truth path.
+  double rpe_delta_meters = 0.0;
+  /// Timestamps of the sequence's images: when given, `coverage` is the share of image frames
+  /// with an estimated pose (a ground truth at 100 Hz or one that misses frames does not
+  /// change it); otherwise matched / ground-truth poses in the estimate's span.
+  std::vector<double> frame_timestamps;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;
@@ -51,13 +58,17 @@ struct EvaluationReport {
   std::size_t matched = 0;
   /// Ground-truth poses whose time lies inside the estimate's [first, last] span.
   std::size_t groundtruth_in_span = 0;
-  double coverage = 0.0;                 ///< matched / groundtruth_in_span
+  double coverage = 0.0;                 ///< see EvaluationOptions::frame_timestamps
+  std::size_t frames = 0;                ///< image frames (0: not known)
+  std::size_t frames_with_pose = 0;      ///< image frames with an estimated pose
   Sim3d S_gt_est;                        ///< alignment applied to the estimate
   ErrorStatistics ate;                   ///< absolute trajectory error of positions after alignment
   double groundtruth_path_length = 0.0;  ///< along the matched ground-truth poses
   double ate_rmse_percent_of_path = 0.0;
   RelativePoseError rpe_per_frame;       ///< consecutive matched poses
   RelativePoseError rpe_per_second;      ///< pairs rpe_delta_seconds apart
+  double rpe_delta_meters = 0.0;         ///< the step actually used
+  RelativePoseError rpe_per_distance;    ///< pairs rpe_delta_meters of ground-truth path apart
   std::vector<KittiSegmentError> kitti;  ///< lengths 100..800 m that fit in the path
 };
 
