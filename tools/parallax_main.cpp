@@ -15,6 +15,7 @@ int Run(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", PARALLAX_VERSION);
   int exit_code = 0;
+  parallax::cli::AddBenchCommand(app, &exit_code);
   parallax::cli::AddDemoCommand(app, &exit_code);
   parallax::cli::AddEvalCommand(app, &exit_code);
   parallax::cli::AddInfoCommand(app, &exit_code);

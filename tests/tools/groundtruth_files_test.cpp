@@ -102,7 +102,7 @@ TEST(GroundTruthFiles, CoverageCountsImageFramesNotGroundTruthPoses) {
     gt.push_back({0.01 * i, SE3d(SO3d(), Eigen::Vector3d(0.01 * i, std::sin(0.02 * i), 0))});
   for (int k = 0; k < 100; ++k) {
     frames.push_back(0.04 * k);
-    if (k % 4 != 3) estimate.push_back({0.04 * k, gt[static_cast<std::size_t>(4 * k)].T_w_c});
+    if (k % 4 != 3) estimate.push_back({0.04 * k, gt[4 * static_cast<std::size_t>(k)].T_w_c});
   }
   EvaluationOptions options;
   EXPECT_LT(Evaluate(estimate, gt, options).coverage, 0.3);  // against the 100 Hz poses

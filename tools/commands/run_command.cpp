@@ -16,7 +16,7 @@ void AddRunCommand(CLI::App& app, int* exit_code) {
   auto options = std::make_shared<RunOptions>();
   auto format = std::make_shared<std::string>("auto");
   auto realtime = std::make_shared<bool>(false);
-  auto config = std::make_shared<std::string>();
+  auto config = std::make_shared<std::vector<std::string>>();
   CLI::App* cmd = app.add_subcommand("run", "Run visual odometry on a dataset");
   cmd->add_option("dataset", options->dataset, "dataset folder or video file")->required();
   cmd->add_option("--format", *format, "auto|tum|monovo|euroc|kitti|images|video");
@@ -25,7 +25,8 @@ void AddRunCommand(CLI::App& app, int* exit_code) {
   cmd->add_option("--out", options->out_dir, "output folder (created)");
   cmd->add_option("--max-frames", options->max_frames, "stop after N frames (0: all)")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--config", *config, "pipeline options, YAML (docs/configuration.md)");
+  cmd->add_option("--config", *config,
+                  "pipeline options, YAML (docs/configuration.md); several are applied in order");
   cmd->add_flag("--realtime", *realtime, "threaded real-time mode (not implemented yet)");
   auto trajectory_format = std::make_shared<std::string>("tum");
   cmd->add_option("--trajectory-format", *trajectory_format,
@@ -40,7 +41,7 @@ void AddRunCommand(CLI::App& app, int* exit_code) {
                                      : RunOptions::TrajectoryFormat::kTum;
     if (*realtime)
       throw std::invalid_argument("--realtime is not implemented yet; the deterministic mode runs");
-    if (!config->empty()) ApplyConfigYaml(*config, &options->system);
+    for (const std::string& file : *config) ApplyConfigYaml(file, &options->system);
     options->dataset_options.format = DatasetFormatFromString(*format);
     options->progress = isatty(STDERR_FILENO) != 0;
     const RunSummary s = RunDataset(*options);

@@ -1,0 +1,75 @@
+#pragma once
+// parallax bench: runs a suite's sequences as separate `parallax run` processes (N at a
+// time, K repeats), evaluates every trajectory with tools/eval, and collects the figures
+// (docs/benchmarks.md, "The harness"). It only orchestrates: metrics live in tools/eval.
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tools/bench/suite.hpp"
+#include "tools/eval/evaluation.hpp"
+
+namespace parallax::bench {
+
+struct BenchOptions {
+  std::string out_dir;
+  int jobs = 1;
+  int repeat = 1;
+  std::string parallax_binary;  ///< the `parallax` executable that runs each sequence
+  std::string cache_dir;        ///< rendered sequences; empty: <out_dir>/cache
+  bool progress = true;         ///< a progress display on stderr
+};
+
+/// Figures of one trajectory against the ground truth.
+struct TrajectoryFigures {
+  std::string estimate;  ///< the file evaluated
+  bool ok = false;
+  std::string error;          ///< why it could not be evaluated
+  double ate_rmse = 0.0;      ///< metres (ground-truth units), after Sim(3) alignment
+  double ate_rmse_se3 = 0.0;  ///< after SE(3) alignment
+  double ate_percent_of_path = 0.0;
+  double coverage = 0.0;  ///< share of image frames with a pose
+  double rpe_frame_translation = 0.0, rpe_frame_rotation_deg = 0.0;
+  double rpe_second_translation = 0.0;
+  double rpe_distance_translation = 0.0, rpe_distance_delta = 0.0;
+  std::vector<KittiSegmentError> kitti;
+};
+
+/// One (sequence, configuration) run: medians over the repeats.
+struct RunRecord {
+  std::string sequence;
+  std::string configuration;
+  std::string command;  ///< the exact command of the first repeat
+  std::string run_dir;
+  std::string groundtruth;  ///< what the estimate was evaluated against
+  int exit_code = 0;        ///< of the first failing repeat, else 0
+  std::string log_tail;     ///< last lines of a failed run's output
+  TrajectoryFigures figures;
+  std::map<std::string, TrajectoryFigures> peers;
+  int frames = 0, frames_tracked = 0, keyframes = 0, loop_closures = 0;
+  double fps = 0.0;  ///< median over repeats
+  std::vector<double> fps_repeats;
+  double tracking_ms_p50 = 0.0, tracking_ms_p95 = 0.0;
+  double mapping_ms_p50 = 0.0, mapping_ms_p95 = 0.0;
+  double optimisation_ms_p50 = 0.0, optimisation_ms_p95 = 0.0;
+  double peak_rss_mb = 0.0;
+  bool Ok() const { return exit_code == 0 && figures.ok; }
+};
+
+struct BenchResult {
+  Suite suite;
+  std::vector<RunRecord> runs;  ///< in suite order: sequences, then configurations
+  double wall_s = 0.0;
+};
+
+/// Renders missing synthetic sequences, runs everything, evaluates. Throws InputError for a
+/// bad suite or output folder; a run that fails is recorded, not thrown.
+BenchResult RunBench(const std::string& suite_file, const BenchOptions& options);
+
+/// Evaluates `estimate` (TUM or KITTI file) against the sequence's ground truth.
+TrajectoryFigures EvaluateTrajectory(const std::string& estimate, const SequenceSpec& sequence,
+                                     std::string* groundtruth_used);
+
+}  // namespace parallax::bench
