@@ -86,6 +86,12 @@ void KeyframeGraph::Compact(const std::vector<std::int64_t>& keep) {
 
 std::vector<Eigen::Vector3f> KeyframeGraph::MapPoints(const PinholeCamera& camera) const {
   std::vector<Eigen::Vector3f> points;
+  ForEachMapPoint(camera, [&](const Eigen::Vector3f& p) { points.push_back(p); });
+  return points;
+}
+
+void KeyframeGraph::ForEachMapPoint(const PinholeCamera& camera,
+                                    const std::function<void(const Eigen::Vector3f&)>& fn) const {
   for (const auto& [id, kf] : keyframes_) {
     const Sim3d& S_w_kf = Pose(id);
     const PinholeCamera& K = camera;
@@ -94,10 +100,9 @@ std::vector<Eigen::Vector3f> KeyframeGraph::MapPoints(const PinholeCamera& camer
       if (!d.confirmed[k]) continue;
       const Eigen::Vector2d px(d.pixel[k] % d.width, d.pixel[k] / d.width);
       const Eigen::Vector3d p = K.Unproject(px) / d.idepth[k];
-      points.push_back((S_w_kf * p).cast<float>());
+      fn((S_w_kf * p).cast<float>());
     }
   }
-  return points;
 }
 
 std::size_t KeyframeGraph::Bytes() const {

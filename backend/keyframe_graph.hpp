@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <vector>
@@ -98,6 +99,9 @@ class KeyframeGraph {
   /// World points of every keyframe's confirmed depth through its current pose; `camera`
   /// is the (level-0) camera of the keyframes.
   std::vector<Eigen::Vector3f> MapPoints(const PinholeCamera& camera) const;
+  /// The same points one at a time (no copy of the whole cloud).
+  void ForEachMapPoint(const PinholeCamera& camera,
+                       const std::function<void(const Eigen::Vector3f&)>& fn) const;
   /// Memory held by the keyframes (frozen depth, tracking references, frame pyramids).
   std::size_t Bytes() const;
   void Clear();

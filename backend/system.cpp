@@ -272,7 +272,13 @@ std::optional<TrackingResult> System::TrackRecentKeyframes(const Frame& frame,
 }
 
 std::vector<Eigen::Vector3f> System::MapPoints() const {
-  std::vector<Eigen::Vector3f> all = graph_.MapPoints(camera_);
+  std::vector<Eigen::Vector3f> all;
+  ForEachMapPoint([&](const Eigen::Vector3f& p) { all.push_back(p); });
+  return all;
+}
+
+void System::ForEachMapPoint(const std::function<void(const Eigen::Vector3f&)>& fn) const {
+  graph_.ForEachMapPoint(camera_, fn);
   if (mapper_.HasMap() && !graph_.Contains(current_.id)) {
     // The current keyframe's confirmed points, through its current pose.
     const InverseDepthMap& map = mapper_.Map();
@@ -283,11 +289,10 @@ std::vector<Eigen::Vector3f> System::MapPoints() const {
         const std::size_t i = map.Index(x, y);
         if (!map.IsConfirmed(i)) continue;
         const Eigen::Vector3d p = K.Unproject(Eigen::Vector2d(x, y)) / map.idepth_smoothed[i];
-        all.push_back((S_w_kf * p).cast<float>());
+        fn((S_w_kf * p).cast<float>());
       }
     }
   }
-  return all;
 }
 
 std::vector<KeyframeRecord> System::Keyframes() const {

@@ -3,6 +3,7 @@
 // depth updates, keyframe creation with propagation and scale normalisation.
 
 #include <deque>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -180,6 +181,8 @@ class System {
   /// Semi-dense points of all keyframes (world coordinates), confirmed estimates only,
   /// through the keyframes' current (optimised) poses.
   std::vector<Eigen::Vector3f> MapPoints() const;
+  /// The same points one at a time (for writing large maps without copying them).
+  void ForEachMapPoint(const std::function<void(const Eigen::Vector3f&)>& fn) const;
   /// Every frame that has a pose, in frame order, through its keyframe's current pose.
   std::vector<FramePose> Trajectory() const;
   const KeyframeGraph& Graph() const { return graph_; }

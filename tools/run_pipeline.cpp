@@ -26,14 +26,19 @@ double Percentile(std::vector<double> values, double q) {
   return values[static_cast<std::size_t>(std::lround(q * static_cast<double>(values.size() - 1)))];
 }
 
-void WritePly(const std::string& path, const std::vector<Eigen::Vector3f>& points) {
+/// Streams the map (two passes: count, then write): millions of points are never copied.
+std::size_t WritePly(const std::string& path, const System& system) {
+  std::size_t count = 0;
+  system.ForEachMapPoint([&](const Eigen::Vector3f&) { ++count; });
   std::ofstream out(path);
   if (!out) throw InputError(path, "cannot open for writing");
-  out << "ply\nformat ascii 1.0\nelement vertex " << points.size()
+  out << "ply\nformat ascii 1.0\nelement vertex " << count
       << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
-  for (const Eigen::Vector3f& p : points)
+  system.ForEachMapPoint([&](const Eigen::Vector3f& p) {
     out << fmt::format("{:.5f} {:.5f} {:.5f}\n", p.x(), p.y(), p.z());
+  });
   if (!out) throw InputError(path, "write failed");
+  return count;
 }
 
 void WriteStats(const std::string& path, const RunSummary& s) {
@@ -189,9 +194,7 @@ RunSummary RunDataset(const RunOptions& options) {
     keyframes.push_back({kf.timestamp, SE3d(kf.S_w_kf.Rotation(), kf.S_w_kf.Translation())});
   }
   WriteTumTrajectory((out / "keyframes.txt").string(), keyframes);
-  const auto points = system.MapPoints();
-  summary.map_points = points.size();
-  WritePly((out / "map.ply").string(), points);
+  summary.map_points = WritePly((out / "map.ply").string(), system);
   WriteStats((out / "stats.json").string(), summary);
   return summary;
 }
