@@ -132,6 +132,17 @@ TEST(TumReader, UsesCalibrationFileAndRejectsBadInput) {
     EXPECT_NE(std::string(e.what()).find("calibration.yaml"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("fx"), std::string::npos) << e.what();
   }
+  // A focal length no lens has (it used to crash the depth filter) names the file too.
+  dir.Write("calibration.yaml",
+            "model: pinhole\nwidth: 32\nheight: 24\nfx: 1e100\nfy: 1e100\ncx: 16\ncy: 12\n");
+  try {
+    OpenDataset(dir.Path().string());
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("calibration.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("implausible calibration: fx = 1e+100"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(DatasetDetection, MissingOrUnknownLayoutsAreReported) {

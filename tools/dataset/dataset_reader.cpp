@@ -2,6 +2,7 @@
 
 #include <filesystem>
 
+#include "core/calibration_check.hpp"
 #include "tools/dataset/file_list_reader.hpp"
 #include "tools/dataset/input_error.hpp"
 
@@ -65,7 +66,9 @@ DatasetFormat DetectDatasetFormat(const std::string& path) {
                    "times.txt, or image files); use --format");
 }
 
-std::unique_ptr<DatasetReader> OpenDataset(const std::string& path, const DatasetOptions& options) {
+namespace {
+
+std::unique_ptr<DatasetReader> OpenLayout(const std::string& path, const DatasetOptions& options) {
   const DatasetFormat format =
       options.format == DatasetFormat::kAuto ? DetectDatasetFormat(path) : options.format;
   if (format != DatasetFormat::kVideo && !fs::is_directory(path)) {
@@ -88,6 +91,22 @@ std::unique_ptr<DatasetReader> OpenDataset(const std::string& path, const Datase
       break;
   }
   throw InputError(path, "unsupported format");
+}
+
+}  // namespace
+
+std::unique_ptr<DatasetReader> OpenDataset(const std::string& path, const DatasetOptions& options) {
+  auto reader = OpenLayout(path, options);
+  // A calibration that no lens can have is a typo or the wrong file, and tracking with it
+  // would still report "tracked" (docs/calibration.md, "Plausibility").
+  const std::string problem = CalibrationProblem(reader->GetCamera());
+  if (!problem.empty()) {
+    std::string source =
+        FindCalibrationFile(fs::is_directory(path) ? path : ".", options.calibration_file);
+    if (source.empty()) source = path;  // the layout's own calibration (calib.txt, ...)
+    throw InputError(source, "implausible calibration: " + problem);
+  }
+  return reader;
 }
 
 }  // namespace parallax
