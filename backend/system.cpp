@@ -23,6 +23,7 @@ void SystemOptions::Check() const {
   depth.Check();
   update_direction.Check();
   bootstrap.Check();
+  quality.Check();
   backend.Check();
   CheckOption(bootstrap_max_frames >= 1, "SystemOptions", "bootstrap_max_frames", "must be >= 1");
   CheckOption(auto_max_rotation_deg > 0.0, "SystemOptions", "auto_max_rotation_deg", "must be > 0");
@@ -154,6 +155,18 @@ FrameResult System::ProcessFrame(const ImageU8& image, double timestamp) {
                 "System::ProcessFrame: image is " + std::to_string(image.Width()) + "x" +
                     std::to_string(image.Height()) + ", the camera " +
                     std::to_string(camera_.Width()) + "x" + std::to_string(camera_.Height()));
+  const FrameQuality quality = AssessFrame(image, options_.quality);
+  if (!quality.Usable()) {
+    // No tracking and no depth update from it: nothing of the map or the motion changes.
+    const std::int64_t id = frame_count_++;
+    frame_timestamps_.push_back(timestamp);
+    ++frames_unusable_;
+    FrameResult result;
+    result.stats.reason = quality.Reason();
+    result.events.push_back({SystemEvent::Kind::kLost, id, -1});
+    Record(id, result);
+    return result;
+  }
   auto frame =
       std::make_shared<const Frame>(frame_count_, timestamp, camera_, image, options_.pyramid);
   ++frame_count_;

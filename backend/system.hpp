@@ -16,6 +16,7 @@
 #include "backend/two_view_bootstrap.hpp"
 #include "backend/update_direction.hpp"
 #include "core/frame.hpp"
+#include "core/frame_quality.hpp"
 #include "core/image.hpp"
 #include "core/pinhole_camera.hpp"
 #include "core/sim3.hpp"
@@ -54,6 +55,9 @@ struct SystemOptions {
   /// Auto and random: start again from the current frame after this many frames lost in a row
   /// before initialisation completed.
   int restart_after_lost = 10;
+  /// Frames without usable structure (blank, dark, blown out, noise) are reported lost
+  /// before tracking: they would otherwise be "tracked" into a garbage pose.
+  FrameQualityOptions quality;
   PyramidOptions pyramid;
   TrackingReferenceOptions reference;
   Se3TrackerOptions tracker;
@@ -188,6 +192,8 @@ class System {
   const KeyframeGraph& Graph() const { return graph_; }
   const BackendStats& Backend() const { return backend_stats_; }
   int FramesProcessed() const { return frame_count_; }
+  /// Frames rejected by the quality gate (SystemOptions::quality).
+  int FramesUnusable() const { return frames_unusable_; }
   /// Index of the frame at which initialisation completed; -1 while initialising.
   int InitialisedAtFrame() const { return initialised_at_frame_; }
 
@@ -287,6 +293,7 @@ class System {
   std::vector<double> frame_timestamps_;
   std::int64_t result_frame_id_ = 0;  ///< the frame being processed (for events)
   int frame_count_ = 0;
+  int frames_unusable_ = 0;
   int depth_updates_ = 0;
   int initialised_at_frame_ = -1;
   /// Frames before initialisation completed, with T_kf_frame (the last good pose if lost),

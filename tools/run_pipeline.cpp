@@ -45,6 +45,8 @@ void WriteStats(const std::string& path, const RunSummary& s) {
   const nlohmann::json j = {
       {"frames", s.frames},
       {"frames_tracked", s.frames_tracked},
+      {"frames_unusable", s.frames_unusable},
+      {"outcome", s.Outcome()},
       {"keyframes", s.keyframes},
       {"loop_closures", s.edges.loop},
       {"keyframe_graph",
@@ -119,6 +121,11 @@ void WriteTrajectory(const std::filesystem::path& out, const std::string& name,
 
 }  // namespace
 
+std::string RunSummary::Outcome() const {
+  if (frames_tracked == 0) return "tracked_nothing";
+  return 2 * frames_tracked >= frames ? "tracked" : "tracked_partially";
+}
+
 RunSummary RunDataset(const RunOptions& options) {
   CheckArgument(options.max_frames >= 0, "--max-frames must be >= 0");
   const auto reader = OpenDataset(options.dataset, options.dataset_options);
@@ -167,6 +174,7 @@ RunSummary RunDataset(const RunOptions& options) {
   }
   summary.frames_tracked = static_cast<int>(trajectory.size());
   summary.initialised_at_frame = system.InitialisedAtFrame();
+  summary.frames_unusable = system.FramesUnusable();
   summary.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary.fps = summary.frames / std::max(summary.wall_s, 1e-9);
   summary.keyframes = static_cast<int>(system.Keyframes().size());

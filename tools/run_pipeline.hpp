@@ -33,6 +33,9 @@ struct RunSummary {
   double peak_rss_mb = 0.0;
   std::size_t map_points = 0;
   int initialised_at_frame = -1;  ///< -1: never initialised
+  int frames_unusable = 0;        ///< rejected by the frame-quality gate
+  /// "tracked" (at least half the frames posed), "tracked_partially" or "tracked_nothing".
+  std::string Outcome() const;
   /// Keyframe graph: edges by kind, optimisations and their cost.
   EdgeCounts edges;
   int optimisations = 0;

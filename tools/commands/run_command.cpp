@@ -51,6 +51,19 @@ void AddRunCommand(CLI::App& app, int* exit_code) {
                   s.frames, s.frames_tracked, 100.0 * s.frames_tracked / s.frames, s.keyframes,
                   s.fps, options->out_dir)
                   .c_str());
+    // Exit codes (docs/cli.md): 0 ran and posed frames, 4 ran and posed none.
+    if (s.frames_tracked == 0) {
+      std::fprintf(stderr,
+                   "parallax: no frame got a pose (%d of %d unusable: blank, dark, blown out or "
+                   "noise); outputs are empty\n",
+                   s.frames_unusable, s.frames);
+      *exit_code = 4;
+      return;
+    }
+    if (2 * s.frames_tracked < s.frames) {
+      std::fprintf(stderr, "parallax: warning: only %d of %d frames got a pose (%d unusable)\n",
+                   s.frames_tracked, s.frames, s.frames_unusable);
+    }
     *exit_code = 0;
   });
 }
