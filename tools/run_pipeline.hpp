@@ -1,6 +1,7 @@
 #pragma once
 // Running the pipeline over a dataset and writing its outputs (design.md section 5).
 
+#include <atomic>
 #include <optional>
 #include <string>
 
@@ -20,6 +21,12 @@ struct RunOptions {
   /// posed frame, with the timestamps in trajectory*.times.txt beside it).
   enum class TrajectoryFormat { kTum, kKitti };
   TrajectoryFormat trajectory_format = TrajectoryFormat::kTum;
+  /// An unreadable or corrupt image is skipped and reported (frames.csv, stats.json); with
+  /// this it ends the run instead (its outputs are still written, marked failed).
+  bool fatal_unreadable = false;
+  /// Polled between frames: when it becomes true the run stops and writes its outputs from
+  /// the map as it stands, marked interrupted (SIGINT/SIGTERM in `parallax run`).
+  const std::atomic<bool>* stop = nullptr;
 };
 
 struct RunSummary {
@@ -34,6 +41,9 @@ struct RunSummary {
   std::size_t map_points = 0;
   int initialised_at_frame = -1;  ///< -1: never initialised
   int frames_unusable = 0;        ///< rejected by the frame-quality gate
+  int frames_unreadable = 0;      ///< unreadable or corrupt images, skipped
+  /// "complete", "interrupted" or "failed: <reason>" (run.json and stats.json).
+  std::string status = "complete";
   /// "tracked" (at least half the frames posed), "tracked_partially" or "tracked_nothing".
   std::string Outcome() const;
   /// Keyframe graph: edges by kind, optimisations and their cost.

@@ -303,6 +303,11 @@ TEST(Pipeline, BadInputIsReportedWithTheFileName) {
   std::ofstream(dir.File("corrupt/calibration.yaml"))
       << "model: pinhole\nwidth: 64\nheight: 48\nfx: 50\nfy: 50\ncx: 31.5\ncy: 23.5\n";
   run.dataset = dir.File("corrupt");
+  // By default the frame is skipped and reported; nothing is posed.
+  const RunSummary skipped = RunDataset(run);
+  EXPECT_EQ(skipped.frames_unreadable, 1);
+  EXPECT_EQ(skipped.frames_tracked, 0);
+  run.fatal_unreadable = true;
   try {
     RunDataset(run);
     FAIL();

@@ -4,6 +4,8 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <csignal>
 #include <cstdio>
 
 #include "tools/commands/commands.hpp"
@@ -11,6 +13,14 @@
 #include "tools/run_pipeline.hpp"
 
 namespace parallax::cli {
+namespace {
+
+// Set by SIGINT/SIGTERM; the run stops between frames and writes what it has.
+std::atomic<bool> g_stop_requested{false};
+
+extern "C" void RequestStop(int /*signal*/) { g_stop_requested.store(true); }
+
+}  // namespace
 
 void AddRunCommand(CLI::App& app, int* exit_code) {
   auto options = std::make_shared<RunOptions>();
@@ -28,6 +38,8 @@ void AddRunCommand(CLI::App& app, int* exit_code) {
   cmd->add_option("--config", *config,
                   "pipeline options, YAML (docs/configuration.md); several are applied in order");
   cmd->add_flag("--realtime", *realtime, "threaded real-time mode (not implemented yet)");
+  cmd->add_flag("--fatal-unreadable", options->fatal_unreadable,
+                "an unreadable image ends the run (default: skipped and reported)");
   auto trajectory_format = std::make_shared<std::string>("tum");
   cmd->add_option("--trajectory-format", *trajectory_format,
                   "trajectory files as tum, or kitti (+ <name>.times.txt)")
@@ -44,14 +56,26 @@ void AddRunCommand(CLI::App& app, int* exit_code) {
     for (const std::string& file : *config) ApplyConfigYaml(file, &options->system);
     options->dataset_options.format = DatasetFormatFromString(*format);
     options->progress = isatty(STDERR_FILENO) != 0;
+    options->stop = &g_stop_requested;
+    std::signal(SIGINT, RequestStop);
+    std::signal(SIGTERM, RequestStop);
     const RunSummary s = RunDataset(*options);
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
     std::printf(
         "%s", fmt::format(
                   "{} frames, {} tracked ({:.1f}%), {} keyframes, {:.1f} frames/s; outputs in {}\n",
                   s.frames, s.frames_tracked, 100.0 * s.frames_tracked / s.frames, s.keyframes,
                   s.fps, options->out_dir)
                   .c_str());
-    // Exit codes (docs/cli.md): 0 ran and posed frames, 4 ran and posed none.
+    // Exit codes (docs/cli.md): 0 ran and posed frames, 4 ran and posed none, 130
+    // interrupted (the outputs hold the frames processed until then).
+    if (s.status == "interrupted") {
+      std::fprintf(stderr, "parallax: interrupted after %d frames; partial outputs in %s\n",
+                   s.frames, options->out_dir.c_str());
+      *exit_code = 130;
+      return;
+    }
     if (s.frames_tracked == 0) {
       std::fprintf(stderr,
                    "parallax: no frame got a pose (%d of %d unusable: blank, dark, blown out or "

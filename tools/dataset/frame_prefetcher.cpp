@@ -1,14 +1,21 @@
 #include "tools/dataset/frame_prefetcher.hpp"
 
+#include <limits>
+
 #include "core/check.hpp"
+#include "tools/dataset/input_error.hpp"
 
 namespace parallax {
 
 FramePrefetcher::FramePrefetcher(DatasetReader* reader, const Undistorter* undistorter,
-                                 std::size_t capacity)
-    : reader_(reader), undistorter_(undistorter), capacity_(capacity) {
+                                 std::size_t capacity, bool skip_unreadable)
+    : reader_(reader),
+      undistorter_(undistorter),
+      capacity_(capacity),
+      skip_unreadable_(skip_unreadable) {
   CheckArgument(reader_ != nullptr && undistorter_ != nullptr,
                 "FramePrefetcher: reader and undistorter are required");
+  timestamps_ = reader_->FrameTimestamps();
   CheckArgument(capacity_ >= 1, "FramePrefetcher: capacity must be >= 1");
   thread_ = std::thread([this] { ReadAhead(); });
 }
@@ -38,9 +45,23 @@ void FramePrefetcher::ReadAhead() {
         prepared->timestamp = frame->timestamp;
         undistorter_->Apply(frame->image, &prepared->image);
       }
+    } catch (const InputError& e) {
+      // The file-list readers move past a frame before reading it, so the next call reads
+      // the frame after the broken one.
+      if (skip_unreadable_ && next_index_ < reader_->NumFrames()) {
+        prepared.emplace();
+        prepared->index = next_index_;
+        prepared->timestamp = next_index_ < timestamps_.size()
+                                  ? timestamps_[next_index_]
+                                  : std::numeric_limits<double>::quiet_NaN();
+        prepared->error = e.what();
+      } else {
+        error = std::current_exception();
+      }
     } catch (...) {
       error = std::current_exception();
     }
+    if (prepared) next_index_ = prepared->index + 1;
     {
       const std::lock_guard<std::mutex> lock(mutex_);
       if (prepared) {

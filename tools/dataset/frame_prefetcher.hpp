@@ -7,7 +7,9 @@
 #include <exception>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "core/undistorter.hpp"
 #include "tools/dataset/dataset_reader.hpp"
@@ -17,8 +19,11 @@ namespace parallax {
 /// A frame ready for System::ProcessFrame: undistorted to the engine's pinhole camera.
 struct PreparedFrame {
   std::size_t index = 0;
-  double timestamp = 0.0;
+  double timestamp = 0.0;  ///< NaN for an unreadable frame whose time the reader cannot tell
   ImageU8 image;
+  /// Non-empty for a frame that could not be read (skip_unreadable): the reader's message
+  /// naming the file; `image` is then empty.
+  std::string error;
 };
 
 /// Decoding a PNG and undistorting it take 2-3 ms of a 640x480 frame's budget on a single
@@ -29,7 +34,10 @@ struct PreparedFrame {
 class FramePrefetcher {
  public:
   /// `reader` and `undistorter` must outlive this object and are used by its thread only.
-  FramePrefetcher(DatasetReader* reader, const Undistorter* undistorter, std::size_t capacity = 4);
+  /// With `skip_unreadable`, an unreadable or corrupt image (InputError from the reader) comes
+  /// out as a frame with `error` set and reading goes on; otherwise Next() rethrows it.
+  FramePrefetcher(DatasetReader* reader, const Undistorter* undistorter, std::size_t capacity = 4,
+                  bool skip_unreadable = false);
   ~FramePrefetcher();
   FramePrefetcher(const FramePrefetcher&) = delete;
   FramePrefetcher& operator=(const FramePrefetcher&) = delete;
@@ -43,6 +51,9 @@ class FramePrefetcher {
   DatasetReader* reader_;
   const Undistorter* undistorter_;
   std::size_t capacity_;
+  bool skip_unreadable_;
+  std::vector<double> timestamps_;  ///< of every frame, when the reader knows them
+  std::size_t next_index_ = 0;
   std::mutex mutex_;
   std::condition_variable space_, ready_;
   std::deque<PreparedFrame> queue_;

@@ -27,29 +27,37 @@ Trajectory ReadTumTrajectory(const std::string& path) {
 
 std::string FormatTimestamp(double seconds) { return fmt::format("{}", seconds); }
 
+std::string FormatTumLine(const StampedPose& pose) {
+  const Eigen::Vector3d& t = pose.T_w_c.Translation();
+  const Eigen::Quaterniond& q = pose.T_w_c.Rotation().UnitQuaternion();
+  return fmt::format("{} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f}",
+                     FormatTimestamp(pose.timestamp), t.x(), t.y(), t.z(), q.x(), q.y(), q.z(),
+                     q.w());
+}
+
+std::string FormatKittiLine(const StampedPose& pose) {
+  const Eigen::Matrix4d T = pose.T_w_c.Matrix();
+  std::string line;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) {
+      if (r > 0 || c > 0) line += ' ';
+      line += fmt::format("{:.9e}", T(r, c));
+    }
+  }
+  return line;
+}
+
 void WriteTumTrajectory(const std::string& path, const Trajectory& trajectory) {
   std::ofstream out(path);
   if (!out) throw InputError(path, "cannot open for writing");
-  for (const StampedPose& pose : trajectory) {
-    const Eigen::Vector3d& t = pose.T_w_c.Translation();
-    const Eigen::Quaterniond& q = pose.T_w_c.Rotation().UnitQuaternion();
-    out << fmt::format("{} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f}\n",
-                       FormatTimestamp(pose.timestamp), t.x(), t.y(), t.z(), q.x(), q.y(), q.z(),
-                       q.w());
-  }
+  for (const StampedPose& pose : trajectory) out << FormatTumLine(pose) << '\n';
   if (!out) throw InputError(path, "write failed");
 }
 
 void WriteKittiTrajectory(const std::string& path, const Trajectory& trajectory) {
   std::ofstream out(path);
   if (!out) throw InputError(path, "cannot open for writing");
-  for (const StampedPose& pose : trajectory) {
-    const Eigen::Matrix4d T = pose.T_w_c.Matrix();
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 4; ++c)
-        out << fmt::format("{:.9e}", T(r, c)) << (r == 2 && c == 3 ? '\n' : ' ');
-    }
-  }
+  for (const StampedPose& pose : trajectory) out << FormatKittiLine(pose) << '\n';
   if (!out) throw InputError(path, "write failed");
 }
 

@@ -32,6 +32,10 @@ void WriteKittiTrajectory(const std::string& path, const Trajectory& trajectory)
 /// Reads KITTI poses (12 numbers per line) with the given timestamps (same count).
 Trajectory ReadKittiTrajectory(const std::string& path, const std::vector<double>& timestamps);
 
+/// One line of each format (no newline).
+std::string FormatTumLine(const StampedPose& pose);
+std::string FormatKittiLine(const StampedPose& pose);
+
 /// Shortest round-trip decimal form of a timestamp.
 std::string FormatTimestamp(double seconds);
 

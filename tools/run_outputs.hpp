@@ -1,0 +1,45 @@
+#pragma once
+// The files a run leaves behind (docs/cli.md, "parallax run"): checked writable before the run,
+// stale ones of an earlier run removed, the live trajectory and the frame log streamed, and the
+// final files written atomically (temporary file + rename) with a manifest, run.json, that
+// says whether the run completed, was interrupted or failed.
+
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "backend/system.hpp"
+#include "tools/dataset/trajectory.hpp"
+#include "tools/run_pipeline.hpp"
+
+namespace parallax {
+
+class RunOutputs {
+ public:
+  /// Creates `out_dir` (throws InputError naming it when it cannot be created or written),
+  /// removes the files an earlier run left there and marks the run as running in run.json.
+  RunOutputs(const std::string& out_dir, RunOptions::TrajectoryFormat format,
+             const std::string& dataset);
+
+  /// One line of frames.csv and, for a posed frame, of trajectory_online.txt (both flushed,
+  /// so an interrupted or crashed run keeps them). `unreadable`: the reader's message.
+  void LogFrame(int index, double timestamp, const FrameResult& result);
+  void LogUnreadable(int index, double timestamp, const std::string& unreadable);
+
+  /// trajectory.txt, keyframes.txt, map.ply and stats.json from the map as it stands, then
+  /// run.json with `status` ("complete", "interrupted" or "failed: <reason>").
+  void Finish(const System& system, RunSummary* summary, const std::string& status);
+
+ private:
+  std::string Path(const std::string& name) const;
+  void WriteManifest(const std::string& status, const std::vector<std::string>& files) const;
+
+  std::string out_dir_;
+  std::string dataset_;
+  RunOptions::TrajectoryFormat format_;
+  std::ofstream frame_log_;
+  std::ofstream online_;
+  std::ofstream online_times_;  ///< KITTI format only
+};
+
+}  // namespace parallax
