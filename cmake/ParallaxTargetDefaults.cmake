@@ -16,8 +16,14 @@ function(parallax_target_defaults target)
   if(PARALLAX_NATIVE_ARCH)
     target_compile_options(${target} PRIVATE -march=native)
   endif()
+  if(PARALLAX_FUZZ)
+    # Coverage feedback from every Parallax library, not only the fuzz targets themselves.
+    target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link)
+  endif()
   if(PARALLAX_SANITIZE)
-    target_compile_options(${target} PUBLIC -fsanitize=${PARALLAX_SANITIZE} -fno-omit-frame-pointer)
+    # A finding must fail the test that caused it: UBSan would otherwise report and go on.
+    target_compile_options(${target} PUBLIC -fsanitize=${PARALLAX_SANITIZE} -fno-omit-frame-pointer
+                                            -fno-sanitize-recover=all)
     target_link_options(${target} PUBLIC -fsanitize=${PARALLAX_SANITIZE})
   endif()
 endfunction()
