@@ -25,8 +25,8 @@ inline const std::filesystem::path& Scratch() {
 inline std::string WriteInput(const std::string& name, const std::uint8_t* data, std::size_t size) {
   const auto path = Scratch() / name;
   std::filesystem::create_directories(path.parent_path());
-  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(data),
-                                              static_cast<std::streamsize>(size));
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
   return path.string();
 }
 
