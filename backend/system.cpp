@@ -40,6 +40,8 @@ void SystemOptions::Check() const {
   CheckOption(min_start_texture >= 0.0 && min_start_texture < 1.0, "SystemOptions",
               "min_start_texture", "must be in [0, 1)");
   CheckOption(max_buffered_frames >= 1, "SystemOptions", "max_buffered_frames", "must be >= 1");
+  CheckOption(max_buffered_megabytes > 0.0, "SystemOptions", "max_buffered_megabytes",
+              "must be > 0");
   CheckOption(min_frames_per_keyframe >= 1, "SystemOptions", "min_frames_per_keyframe",
               "must be >= 1");
   CheckOption(initialization_updates >= 1, "SystemOptions", "initialization_updates",

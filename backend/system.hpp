@@ -89,6 +89,9 @@ struct SystemOptions {
   /// At most this many frames are kept for re-tracking before initialisation completes (a
   /// static start would otherwise keep them all); older ones keep their first pose.
   int max_buffered_frames = 60;
+  /// ... and at most this many bytes of their pyramids (an 8000x6000 frame's pyramid is
+  /// about 1 GB: a count alone does not bound memory).
+  double max_buffered_megabytes = 512.0;
   /// Constraint search and pose-graph optimisation when a keyframe is finished; false keeps
   /// the tracking chain as it is (odometry edges only, never optimised).
   bool optimize_graph = true;

@@ -1,5 +1,6 @@
 // System: the start of a sequence (design.md section 3a, docs/configuration.md).
 
+#include <algorithm>
 #include <cmath>
 
 #include "backend/system.hpp"
@@ -54,7 +55,16 @@ void System::BufferInitialFrame(const std::shared_ptr<const Frame>& frame, const
   initial_frames_.emplace_back(frame, T_kf_frame);
   // A camera that does not move before initialisation would otherwise buffer every frame
   // (a few MB each); the oldest keep the pose they were given, or stay without one.
-  if (static_cast<int>(initial_frames_.size()) > options_.max_buffered_frames) {
+  std::size_t pyramid_bytes = 0;
+  for (int l = 0; l < frame->NumLevels(); ++l) {
+    pyramid_bytes += static_cast<std::size_t>(frame->Level(l).Width() * frame->Level(l).Height()) *
+                     4 * sizeof(float);  // intensity, dx, dy, grad_sq
+  }
+  const auto by_bytes = static_cast<std::size_t>(options_.max_buffered_megabytes * 1e6 /
+                                                 static_cast<double>(pyramid_bytes));
+  const std::size_t limit = std::max<std::size_t>(
+      1, std::min(by_bytes, static_cast<std::size_t>(options_.max_buffered_frames)));
+  if (initial_frames_.size() > limit) {
     initial_frames_.erase(initial_frames_.begin());
   }
 }

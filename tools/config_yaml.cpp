@@ -77,6 +77,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"min_frames_per_keyframe", Set(&o->min_frames_per_keyframe)},
         {"recent_keyframes", Set(&o->recent_keyframes)},
         {"max_buffered_frames", Set(&o->max_buffered_frames)},
+        {"max_buffered_megabytes", Set(&o->max_buffered_megabytes)},
         {"initialization_updates", Set(&o->initialization_updates)},
         {"update_direction", Set(&o->update_direction.enabled)},
         {"update_direction_weight", Set(&o->update_direction.essential_weight)},
