@@ -226,6 +226,16 @@ TEST(TumMonoReader, RelativeFovCameraAndExposures) {
   EXPECT_EQ(reader->SuggestedRectification().mode, UndistortMode::kCrop);
   dir.Write("times.txt", "00000 1.5 10.0\n");
   EXPECT_THROW(OpenDataset(dir.Path().string()), InputError);  // count mismatch
+  // An image size beyond int (found by fuzz_dataset: it was undefined behaviour) is named.
+  dir.Write("times.txt", "00000 1.5 10.0\n00001 1.6 12.5\n");
+  dir.Write("camera.txt", "0.5 0.6 0.5 0.5 0.9\n1.7e23 24\ncrop\n32 24\n");
+  try {
+    OpenDataset(dir.Path().string());
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.Line(), 2) << e.what();
+    EXPECT_NE(std::string(e.what()).find("image width"), std::string::npos) << e.what();
+  }
 }
 
 TEST(ImageFolderReader, NaturalOrderAndFpsTimestamps) {

@@ -38,6 +38,16 @@ std::vector<std::string> SplitFields(const std::string& line) {
   return fields;
 }
 
+int ToImageDimension(double value, const std::string& path, int line_number,
+                     const std::string& what) {
+  if (!(value >= 1.0 && value <= 65536.0 && value == std::floor(value))) {
+    throw InputError(
+        path, line_number,
+        what + " must be a whole number of pixels in [1, 65536], got " + std::to_string(value));
+  }
+  return static_cast<int>(value);
+}
+
 double ParseDouble(const std::string& text, const std::string& path, int line_number,
                    const std::string& what) {
   double value = 0.0;

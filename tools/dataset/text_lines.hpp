@@ -21,6 +21,11 @@ std::vector<std::string> SplitFields(const std::string& line);
 std::vector<double> ParseNumbers(const std::string& line, const std::string& path, int line_number,
                                  std::size_t count, bool allow_more = false);
 
+/// An image dimension: a whole number of pixels in [1, 65536]; throws InputError naming the
+/// field otherwise (a double outside int's range must not reach a cast).
+int ToImageDimension(double value, const std::string& path, int line_number,
+                     const std::string& what);
+
 /// Parses one finite double; throws InputError naming the field on failure.
 double ParseDouble(const std::string& text, const std::string& path, int line_number,
                    const std::string& what);

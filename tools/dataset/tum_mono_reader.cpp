@@ -47,8 +47,8 @@ MonoCameraFile ReadMonoCameraFile(const std::string& file) {
   values.reserve(fields.size());
   for (const auto& f : fields) values.push_back(ParseDouble(f, file, 1, "camera parameter"));
   const auto size = ParseNumbers(lines[1], file, 2, 2);
-  const int w = static_cast<int>(size[0]);
-  const int h = static_cast<int>(size[1]);
+  const int w = ToImageDimension(size[0], file, 2, "image width");
+  const int h = ToImageDimension(size[1], file, 2, "image height");
   CameraModel model;
   if (model_name == "FOV") {
     model = CameraModel::kFov;
@@ -76,8 +76,8 @@ MonoCameraFile ReadMonoCameraFile(const std::string& file) {
   };
   MonoCameraFile result{make_camera(), {}};
   const auto out_size = ParseNumbers(lines[3], file, 4, 2);
-  result.rectification.output_width = static_cast<int>(out_size[0]);
-  result.rectification.output_height = static_cast<int>(out_size[1]);
+  result.rectification.output_width = ToImageDimension(out_size[0], file, 4, "output width");
+  result.rectification.output_height = ToImageDimension(out_size[1], file, 4, "output height");
   const auto mode = SplitFields(lines[2]);
   if (mode.size() == 1 && mode[0] == "crop") {
     result.rectification.mode = UndistortMode::kCrop;
