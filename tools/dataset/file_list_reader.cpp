@@ -1,6 +1,10 @@
 #include "tools/dataset/file_list_reader.hpp"
 
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "tools/dataset/input_error.hpp"
@@ -17,10 +21,48 @@ void CheckTimestampsIncrease(const std::vector<ImageEntry>& entries) {
   }
 }
 
-ImageU8 ReadGreyImage(const std::string& path, int expected_width, int expected_height) {
+namespace {
+
+/// OpenCV picks a decoder by the file's content and links many (DICOM, JPEG 2000, OpenEXR,
+/// ...); some abort the process on malformed input (fuzz_image found GDCM asserting). Only
+/// the formats image sequences come in reach a decoder.
+void CheckImageSignature(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char b[12] = {};
+  in.read(reinterpret_cast<char*>(b), sizeof(b));
+  const auto n = static_cast<std::size_t>(in.gcount());
+  const auto starts = [&](std::initializer_list<unsigned char> sig) {
+    return n >= sig.size() && std::equal(sig.begin(), sig.end(), b);
+  };
+  const bool png = starts({0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a});
+  const bool jpeg = starts({0xff, 0xd8, 0xff});
+  const bool bmp = starts({'B', 'M'});
+  const bool tiff = starts({'I', 'I', 0x2a, 0x00}) || starts({'M', 'M', 0x00, 0x2a});
+  const bool pnm = n >= 2 && b[0] == 'P' && b[1] >= '1' && b[1] <= '6';
+  const bool webp = n >= 12 && starts({'R', 'I', 'F', 'F'}) && b[8] == 'W' && b[9] == 'E' &&
+                    b[10] == 'B' && b[11] == 'P';
+  if (!(png || jpeg || bmp || tiff || pnm || webp)) {
+    throw InputError(path, "not a PNG, JPEG, BMP, TIFF, PGM/PPM or WebP image");
+  }
+}
+
+cv::Mat DecodeGrey(const std::string& path) {
   if (!std::filesystem::exists(path)) throw InputError(path, "image file does not exist");
-  const cv::Mat grey = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  CheckImageSignature(path);
+  cv::Mat grey;
+  try {
+    grey = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  } catch (const cv::Exception& e) {
+    throw InputError(path, std::string("cannot decode: ") + e.what());
+  }
   if (grey.empty()) throw InputError(path, "unreadable or corrupt image");
+  return grey;
+}
+
+}  // namespace
+
+ImageU8 ReadGreyImage(const std::string& path, int expected_width, int expected_height) {
+  const cv::Mat grey = DecodeGrey(path);
   if (grey.cols != expected_width || grey.rows != expected_height) {
     throw InputError(path, "image is " + std::to_string(grey.cols) + "x" +
                                std::to_string(grey.rows) + " but the camera is " +
@@ -35,9 +77,7 @@ ImageU8 ReadGreyImage(const std::string& path, int expected_width, int expected_
 }
 
 std::pair<int, int> ProbeImageSize(const std::string& path) {
-  if (!std::filesystem::exists(path)) throw InputError(path, "image file does not exist");
-  const cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (image.empty()) throw InputError(path, "unreadable or corrupt image");
+  const cv::Mat image = DecodeGrey(path);
   return {image.cols, image.rows};
 }
 
