@@ -112,6 +112,19 @@ TEST(BenchRunner, FiguresMatchEvalAndParallelEqualsSerial) {
   EXPECT_TRUE(CompareWithBaseline(parallel, dir.File("close.json")).empty());
 }
 
+TEST(BenchRunner, RepeatsOfADeterministicRunAreIdentical) {
+  const TempDir dir;
+  BenchOptions options = Options(dir, "repeat", 2);
+  options.repeat = 2;
+  const std::string suite =
+      "sequences:\n  - {name: room, synth: {scene: room, motion: shake, frames: 30, width: 320, "
+      "height: 240}}\n";
+  const BenchResult r = RunBench(dir.Write("one.yaml", suite), options);
+  ASSERT_EQ(r.runs.size(), 1u);
+  EXPECT_EQ(r.runs[0].fps_repeats.size(), 2u);
+  EXPECT_TRUE(r.runs[0].repeats_identical);
+}
+
 TEST(BenchRunner, PeersAreEvaluatedLikeTheRun) {
   const TempDir dir;
   // The peer is the ground truth itself: zero error, full coverage.

@@ -84,6 +84,13 @@ std::string Tail(const std::string& file, std::size_t lines) {
   return text;
 }
 
+std::string ReadAll(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
 double Median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -246,6 +253,11 @@ BenchResult RunBench(const std::string& suite_file, const BenchOptions& options)
     for (std::size_t c = 0; c < result.suite.configurations.size(); ++c, ++index) {
       RunRecord& r = result.runs[index];
       r.fps = Median(r.fps_repeats);
+      const std::string first = ReadAll(fs::path(r.run_dir) / "repeat0" / "trajectory.txt");
+      for (int k = 1; k < options.repeat && r.exit_code == 0; ++k) {
+        const fs::path other = fs::path(r.run_dir) / fmt::format("repeat{}", k) / "trajectory.txt";
+        r.repeats_identical = r.repeats_identical && ReadAll(other) == first;
+      }
       const std::string estimate = (fs::path(r.run_dir) / "repeat0" / "trajectory.txt").string();
       if (r.exit_code == 0) r.figures = EvaluateTrajectory(estimate, s, &r.groundtruth);
       for (const auto& [name, file] : s.peers) r.peers[name] = EvaluateTrajectory(file, s, nullptr);

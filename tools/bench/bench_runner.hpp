@@ -55,6 +55,9 @@ struct RunRecord {
   double mapping_ms_p50 = 0.0, mapping_ms_p95 = 0.0;
   double optimisation_ms_p50 = 0.0, optimisation_ms_p95 = 0.0;
   double peak_rss_mb = 0.0;
+  /// With --repeat > 1: whether every repeat wrote the same trajectory.txt, byte for byte
+  /// (the deterministic mode's promise); true for a single run.
+  bool repeats_identical = true;
   bool Ok() const { return exit_code == 0 && figures.ok; }
 };
 

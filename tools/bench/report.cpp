@@ -115,7 +115,8 @@ std::string ReportJson(const BenchResult& result, const std::string& invocation)
         {"tracking_ms", {{"p50", r.tracking_ms_p50}, {"p95", r.tracking_ms_p95}}},
         {"mapping_ms", {{"p50", r.mapping_ms_p50}, {"p95", r.mapping_ms_p95}}},
         {"optimisation_ms", {{"p50", r.optimisation_ms_p50}, {"p95", r.optimisation_ms_p95}}},
-        {"peak_rss_mb", r.peak_rss_mb}};
+        {"peak_rss_mb", r.peak_rss_mb},
+        {"repeats_identical", r.repeats_identical}};
     if (!r.log_tail.empty()) run["log_tail"] = r.log_tail;
     nlohmann::json peers = nlohmann::json::object();
     for (const auto& [name, f] : r.peers) peers[name] = FiguresJson(f);
