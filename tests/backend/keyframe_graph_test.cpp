@@ -19,12 +19,7 @@
 namespace parallax {
 namespace {
 
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::ReadFile;
 
 class KeyframeGraphTest : public ::testing::Test {
  protected:

@@ -21,12 +21,7 @@
 namespace parallax {
 namespace {
 
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::ReadFile;
 
 class PipelineTest : public ::testing::Test {
  protected:

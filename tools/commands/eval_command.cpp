@@ -38,18 +38,10 @@ void RunEval(const EvalArgs& args) {
   } else {
     groundtruth = ReadTrajectoryFile({args.groundtruth, args.times, args.sensor});
   }
-  if (!args.frames.empty())
-    options.frame_timestamps = ReadDatasetGroundTruth(args.frames).frame_timestamps;
-  // A KITTI-format estimate without its own times takes the ground truth's, as KITTI's devkit
-  // does (one pose per image).
-  std::string estimate_times = args.estimate_times;
-  if (estimate_times.empty() &&
-      DetectTrajectoryFormat(args.estimate) == TrajectoryFileFormat::kKitti &&
-      !std::filesystem::exists(
-          std::filesystem::path(args.estimate).replace_extension(".times.txt"))) {
-    estimate_times = args.times;
-  }
-  const Trajectory estimate = ReadTrajectoryFile({args.estimate, estimate_times, ""});
+  // Only the image timestamps are wanted here: the folder need not have ground truth.
+  if (!args.frames.empty()) options.frame_timestamps = OpenDataset(args.frames)->FrameTimestamps();
+  const Trajectory estimate =
+      ReadTrajectoryFile({args.estimate, args.estimate_times, "", args.times});
   const EvaluationReport report = Evaluate(estimate, groundtruth, options);
   const std::string text = args.json ? ReportToJson(report) + "\n" : FormatReport(report);
   std::fputs(text.c_str(), stdout);

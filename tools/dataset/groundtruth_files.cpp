@@ -19,13 +19,15 @@ std::vector<double> ReadTimes(const std::string& path) {
   return times;
 }
 
-std::string FindKittiTimes(const std::string& poses, const std::string& given) {
+std::string FindKittiTimes(const std::string& poses, const std::string& given,
+                           const std::string& fallback) {
   if (!given.empty()) return given;
   const fs::path p(poses);
   const fs::path sibling = p.parent_path() / (p.stem().string() + ".times.txt");
   if (fs::exists(sibling)) return sibling.string();
   const fs::path layout = p.parent_path().parent_path() / "sequences" / p.stem() / "times.txt";
   if (fs::exists(layout)) return layout.string();
+  if (!fallback.empty()) return fallback;
   throw InputError(poses, "KITTI poses need timestamps: give --times (times.txt), or put " +
                               sibling.filename().string() + " beside the file");
 }
@@ -64,7 +66,7 @@ Trajectory ReadTrajectoryFile(const TrajectorySource& source) {
     case TrajectoryFileFormat::kEuroc:
       return ReadEurocGroundTruthFile(source.path, FindEurocSensor(source.path, source.sensor));
     case TrajectoryFileFormat::kKitti: {
-      const std::string times = FindKittiTimes(source.path, source.times);
+      const std::string times = FindKittiTimes(source.path, source.times, source.fallback_times);
       return ReadKittiTrajectory(source.path, ReadTimes(times));
     }
     case TrajectoryFileFormat::kTum:

@@ -23,6 +23,9 @@ struct TrajectorySource {
   std::string path;
   std::string times;
   std::string sensor;
+  /// KITTI timestamps used when `times` is empty and none are found beside the file (an
+  /// estimate with one pose per image takes the ground truth's, as KITTI's devkit does).
+  std::string fallback_times = {};
 };
 
 /// The format by content: EuRoC for a .csv whose lines have >= 8 numbers, KITTI for 12
