@@ -38,13 +38,13 @@ void AddDemoCommand(CLI::App& app, int* exit_code) {
                  ReadTumTrajectory(run.dataset + "/groundtruth.txt"), {});
     std::printf(
         "%s",
-        fmt::format(
-            "frames {}  tracked {} ({:.1f}%)  keyframes {}  {:.1f} frames/s\n"
-            "ATE RMSE {:.4f} m after Sim(3) alignment ({:.2f}% of the {:.2f} m path)\n"
-            "sequence: {}\noutputs:  {} (trajectory.txt, keyframes.txt, map.ply, stats.json)\n",
-            s.frames, s.frames_tracked, 100.0 * s.frames_tracked / s.frames, s.keyframes, s.fps,
-            report.ate.rmse, report.ate_rmse_percent_of_path, report.groundtruth_path_length,
-            run.dataset, run.out_dir)
+        fmt::format("frames {}  tracked {} ({:.1f}%)  keyframes {}  {:.1f} frames/s\n"
+                    "ATE RMSE {:.4f} m after Sim(3) alignment ({:.2f}% of the {:.2f} m path)\n"
+                    "sequence: {}\noutputs:  {} (trajectory.txt, trajectory_online.txt, "
+                    "keyframes.txt, map.ply, stats.json, frames.csv, run.json)\n",
+                    s.frames, s.frames_tracked, 100.0 * s.frames_tracked / s.frames, s.keyframes,
+                    s.fps, report.ate.rmse, report.ate_rmse_percent_of_path,
+                    report.groundtruth_path_length, run.dataset, run.out_dir)
             .c_str());
     *exit_code = 0;
   });
