@@ -30,7 +30,7 @@ GraphBackend::GraphBackend(const GraphBackendOptions& options, const KeyframeBui
 
 GraphBackend::Alignment GraphBackend::Align(const KeyframeGraph& graph, std::int64_t a_id,
                                             std::int64_t b_id, const Sim3d& S_a_b_guess,
-                                            BackendReport* report) {
+                                            BackendReport* report, bool accept_poor) {
   Alignment out;
   const auto a_ptr =
       Materialize(graph.GetPtr(a_id), build_.camera, build_.pyramid, build_.reference);
@@ -39,22 +39,26 @@ GraphBackend::Alignment GraphBackend::Align(const KeyframeGraph& graph, std::int
   const Keyframe& a = *a_ptr;
   const Keyframe& b = *b_ptr;
   report->alignments += 2;
+  const auto usable = [&](TrackingStatus status) {
+    return status == TrackingStatus::kOk || (accept_poor && status == TrackingStatus::kPoor);
+  };
   const Sim3TrackingResult a_b = aligner_.Track(*a.reference, *b.reference, S_a_b_guess);
-  if (a_b.status != TrackingStatus::kOk) return out;
+  if (!usable(a_b.status)) return out;
   const Sim3TrackingResult b_a =
       aligner_.Track(*b.reference, *a.reference, a_b.S_ref_other.Inverse());
-  if (b_a.status != TrackingStatus::kOk) return out;
+  if (!usable(b_a.status)) return out;
+  out.converged = true;
+  out.S_a_b = a_b.S_ref_other;
+  out.S_a_b_reverse = b_a.S_ref_other.Inverse();
   // The distance with the graph's (scaled) information: scaling the information by s
   // scales the distance by s.
-  const double distance = options_.information_scale * ReciprocalMahalanobis(a_b, b_a);
-  if (!(distance < options_.max_reciprocal_mahalanobis)) return out;
-  out.accepted = true;
-  out.S_a_b = a_b.S_ref_other;
+  out.reciprocal_distance = options_.information_scale * ReciprocalMahalanobis(a_b, b_a);
   // The tracker's information is for S' = Exp(eps) S_a_b; the graph residual of the edge is
   // r = Adj(S_a_b^-1) eps to first order, so Omega_r = Adj(S)^T Omega_eps Adj(S).
   const Matrix7d adjoint = out.S_a_b.Adjoint();
   out.information = options_.information_scale * adjoint.transpose() * a_b.information * adjoint;
   out.information = 0.5 * (out.information + out.information.transpose()).eval();
+  out.accepted = out.reciprocal_distance < options_.max_reciprocal_mahalanobis;
   return out;
 }
 

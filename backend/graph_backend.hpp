@@ -69,15 +69,23 @@ class GraphBackend {
 
   const GraphBackendOptions& Options() const { return options_; }
 
- private:
+  /// A direct Sim(3) alignment of two keyframes, checked both ways.
   struct Alignment {
-    bool accepted = false;
-    Sim3d S_a_b;
+    bool converged = false;  ///< both directions converged (the fields below are set)
+    bool accepted = false;   ///< ... and passed the reciprocal check
+    Sim3d S_a_b;             ///< a aligned to b
+    Sim3d S_a_b_reverse;     ///< b aligned to a, inverted
     Matrix7d information = Matrix7d::Zero();  ///< in pose-graph residual coordinates
+    double reciprocal_distance = 0.0;         ///< with the scaled information
   };
-  /// Aligns keyframes a and b both ways from the guess S_a_b.
+  /// Aligns keyframes a and b both ways from the guess S_a_b (compacted keyframes are
+  /// rebuilt for it); accepted when both directions converge "ok" (or "poor" too, with
+  /// `accept_poor`) and pass the reciprocal check; a converged pair that fails the check
+  /// is returned with accepted = false (place recognition applies its own gate).
   Alignment Align(const KeyframeGraph& graph, std::int64_t a, std::int64_t b,
-                  const Sim3d& S_a_b_guess, BackendReport* report);
+                  const Sim3d& S_a_b_guess, BackendReport* report, bool accept_poor = false);
+
+ private:
   std::vector<std::int64_t> NeighbourCandidates(const KeyframeGraph& graph, std::int64_t id,
                                                 std::optional<std::int64_t> parent) const;
 

@@ -25,6 +25,7 @@ void SystemOptions::Check() const {
   bootstrap.Check();
   quality.Check();
   backend.Check();
+  loop_closure.Check();
   CheckOption(bootstrap_max_frames >= 1, "SystemOptions", "bootstrap_max_frames", "must be >= 1");
   CheckOption(auto_max_rotation_deg > 0.0, "SystemOptions", "auto_max_rotation_deg", "must be > 0");
   CheckOption(auto_max_direction_deg > 0.0, "SystemOptions", "auto_max_direction_deg",
@@ -54,7 +55,8 @@ System::System(const PinholeCamera& camera, const SystemOptions& options)
       tracker_(options.tracker),
       mapper_(camera, options.depth, options.update_direction, options.reference,
               options.recent_keyframes),
-      backend_(options.backend, KeyframeBuildOptions{camera, options.pyramid, options.reference}) {
+      backend_(options.backend, KeyframeBuildOptions{camera, options.pyramid, options.reference}),
+      loop_closer_(options.loop_closure, Vocabulary::Default(), camera) {
   options_.Check();
 }
 
@@ -109,6 +111,27 @@ void System::FinishCurrentKeyframe(FrameResult* result) {
     backend_stats_.optimisation_ms.push_back(MillisecondsSince(start));
     result->events.push_back({SystemEvent::Kind::kGraphOptimised, result_frame_id_, keyframe->id});
   }
+  CloseLoops(keyframe->id, result);
+}
+
+void System::CloseLoops(std::int64_t id, FrameResult* result) {
+  if (!options_.loop_closure.enabled) return;
+  const auto start = Clock::now();
+  const LoopReport loop = loop_closer_.KeyframeFinished(&graph_, &backend_, id);
+  backend_stats_.loop_candidates += loop.candidates;
+  backend_stats_.loop_checks += loop.consistent;
+  backend_stats_.loops_rejected += loop.rejected;
+  if (loop.optimisation) {
+    ++backend_stats_.optimisations;
+    backend_stats_.iterations += loop.optimisation->iterations;
+  }
+  backend_stats_.loop_ms.push_back(MillisecondsSince(start));
+  if (loop.loop_keyframe) {
+    ++backend_stats_.loops_closed;
+    result->events.push_back(
+        {SystemEvent::Kind::kLoopClosed, result_frame_id_, id, *loop.loop_keyframe});
+    result->events.push_back({SystemEvent::Kind::kGraphOptimised, result_frame_id_, id});
+  }
 }
 
 void System::StartKeyframe(const std::shared_ptr<const Frame>& frame, const Sim3d& S_w_kf,
@@ -147,6 +170,7 @@ void System::Record(std::int64_t frame_id, const FrameResult& result) {
 
 void System::ClearMap() {
   graph_.Clear();
+  loop_closer_.Clear();
   mapper_.Clear();
   current_ = CurrentKeyframe{};
 }

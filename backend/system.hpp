@@ -12,6 +12,7 @@
 #include "backend/frame_tracker.hpp"
 #include "backend/graph_backend.hpp"
 #include "backend/keyframe_graph.hpp"
+#include "backend/loop_closer.hpp"
 #include "backend/mapper.hpp"
 #include "backend/two_view_bootstrap.hpp"
 #include "backend/update_direction.hpp"
@@ -96,6 +97,8 @@ struct SystemOptions {
   /// the tracking chain as it is (odometry edges only, never optimised).
   bool optimize_graph = true;
   GraphBackendOptions backend;
+  /// Place recognition and loop closure on finished keyframes (needs optimize_graph).
+  LoopClosureOptions loop_closure;
 
   void Check() const;
 };
@@ -120,10 +123,12 @@ struct SystemEvent {
     kRecovered,         ///< tracked again on a recent keyframe (keyframe_id)
     kPosesRevised,      ///< earlier frames' poses revised or withdrawn (initialisation)
     kRestarted,         ///< the start failed and began again at this frame
+    kLoopClosed,        ///< keyframe_id closed a loop with loop_keyframe_id; graph optimised
   };
   Kind kind = Kind::kLost;
   std::int64_t frame_id = 0;
   std::int64_t keyframe_id = -1;
+  std::int64_t loop_keyframe_id = -1;  ///< kLoopClosed: the earlier keyframe
 };
 
 /// A frame's pose as the map holds it: relative to a keyframe, so that a correction of the
@@ -147,6 +152,11 @@ struct BackendStats {
   int alignments = 0;
   int edges_rejected = 0;
   std::vector<double> optimisation_ms;
+  int loop_candidates = 0;  ///< database candidates above the score gates
+  int loop_checks = 0;      ///< consistent candidates verified geometrically
+  int loops_rejected = 0;   ///< of them, failed verification
+  int loops_closed = 0;
+  std::vector<double> loop_ms;  ///< place recognition per finished keyframe
 };
 
 /// Per-frame outcome.
@@ -194,6 +204,8 @@ class System {
   std::vector<FramePose> Trajectory() const;
   const KeyframeGraph& Graph() const { return graph_; }
   const BackendStats& Backend() const { return backend_stats_; }
+  /// Memory held by place recognition (keyframe features and vectors).
+  std::size_t PlaceRecognitionBytes() const { return loop_closer_.Recognizer().Bytes(); }
   int FramesProcessed() const { return frame_count_; }
   /// Frames rejected by the quality gate (SystemOptions::quality).
   int FramesUnusable() const { return frames_unusable_; }
@@ -206,6 +218,8 @@ class System {
                      InverseDepthMap map, FrameResult* result);
   /// Freezes the current keyframe into the graph and runs the backend on it.
   void FinishCurrentKeyframe(FrameResult* result);
+  /// Place recognition for the finished keyframe `id`; a verified loop becomes an edge.
+  void CloseLoops(std::int64_t id, FrameResult* result);
   /// Keyframe-to-world pose of the current keyframe (through its parent while unfinished).
   Sim3d CurrentKeyframePose() const;
   Sim3d KeyframePose(std::int64_t id) const;
@@ -280,6 +294,7 @@ class System {
   FrameTracker tracker_;
   Mapper mapper_;
   GraphBackend backend_;
+  LoopCloser loop_closer_;
   BackendStats backend_stats_;
   /// Finished keyframes and their poses (the map).
   KeyframeGraph graph_;

@@ -98,6 +98,22 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"optimizer_max_iterations", Set(&o->backend.optimizer.max_iterations)},
         {"alignment_finest_level", Set(&o->backend.alignment.finest_level)},
         {"optimizer_kernel_width", Set(&o->backend.optimizer.kernel_width)}}},
+      {"loop_closure",
+       {{"enabled", Set(&o->loop_closure.enabled)},
+        {"orb_features", Set(&o->loop_closure.place.orb.max_features)},
+        {"max_match_distance", Set(&o->loop_closure.place.max_match_distance)},
+        {"match_ratio", Set(&o->loop_closure.place.match_ratio)},
+        {"exclude_recent_keyframes", Set(&o->loop_closure.exclude_recent_keyframes)},
+        {"min_score", Set(&o->loop_closure.min_score)},
+        {"max_candidates", Set(&o->loop_closure.max_candidates)},
+        {"consistency", Set(&o->loop_closure.consistency)},
+        {"min_matches", Set(&o->loop_closure.min_matches)},
+        {"max_relative_depth_std", Set(&o->loop_closure.max_relative_depth_std)},
+        {"max_correction_per_path", Set(&o->loop_closure.max_correction_per_path)},
+        {"ransac_min_inliers", Set(&o->loop_closure.ransac.min_inliers)},
+        {"ransac_max_iterations", Set(&o->loop_closure.ransac.max_iterations)},
+        {"ransac_max_reprojection_chi2", Set(&o->loop_closure.ransac.max_reprojection_chi2)},
+        {"optimizer_max_iterations", Set(&o->loop_closure.optimizer.max_iterations)}}},
   };
 }
 
@@ -120,9 +136,10 @@ void ApplyConfigYaml(const std::string& path, SystemOptions* options) {
     const std::string name = section.first.as<std::string>();
     const auto found = sections.find(name);
     if (found == sections.end()) {
-      throw InputError(path, LineOf(section.first),
-                       "unknown section '" + name +
-                           "' (expected pyramid, reference, tracker, depth, system or backend)");
+      throw InputError(
+          path, LineOf(section.first),
+          "unknown section '" + name +
+              "' (expected pyramid, reference, tracker, depth, system, backend or loop_closure)");
     }
     if (!section.second.IsMap())
       throw InputError(path, LineOf(section.second), "section '" + name + "' must be a mapping");

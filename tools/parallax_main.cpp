@@ -22,6 +22,7 @@ int Run(int argc, char** argv) {
   parallax::cli::AddPosegraphCommand(app, &exit_code);
   parallax::cli::AddRunCommand(app, &exit_code);
   parallax::cli::AddSynthCommand(app, &exit_code);
+  parallax::cli::AddVocabularyCommand(app, &exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -75,6 +75,13 @@ void WriteStats(const std::string& path, const RunSummary& s) {
         {"bytes", s.graph_bytes},
         {"bytes_per_keyframe",
          s.keyframes > 0 ? s.graph_bytes / static_cast<std::size_t>(s.keyframes) : 0}}},
+      {"place_recognition",
+       {{"loop_candidates", s.loop_candidates},
+        {"loops_verified", s.loop_checks},
+        {"loops_rejected", s.loops_rejected},
+        {"loops_closed", s.loops_closed},
+        {"ms_per_keyframe", {{"p50", s.loop_ms_p50}, {"p95", s.loop_ms_p95}}},
+        {"bytes", s.place_bytes}}},
       {"relocalisations", 0},
       {"initialised_at_frame", s.initialised_at_frame},
       {"wall_s", s.wall_s},
@@ -113,6 +120,9 @@ std::string EventNames(const std::vector<SystemEvent>& events) {
         break;
       case SystemEvent::Kind::kRestarted:
         names += "restarted";
+        break;
+      case SystemEvent::Kind::kLoopClosed:
+        names += "loop:" + std::to_string(e.loop_keyframe_id);
         break;
     }
   }

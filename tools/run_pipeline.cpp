@@ -58,6 +58,13 @@ void Summarise(const System& system, const std::vector<double>& tracking_ms,
   summary->optimisation_ms_p50 = Percentile(system.Backend().optimisation_ms, 0.5);
   summary->optimisation_ms_p95 = Percentile(system.Backend().optimisation_ms, 0.95);
   summary->graph_bytes = system.Graph().Bytes();
+  summary->loop_candidates = system.Backend().loop_candidates;
+  summary->loop_checks = system.Backend().loop_checks;
+  summary->loops_rejected = system.Backend().loops_rejected;
+  summary->loops_closed = system.Backend().loops_closed;
+  summary->loop_ms_p50 = Percentile(system.Backend().loop_ms, 0.5);
+  summary->loop_ms_p95 = Percentile(system.Backend().loop_ms, 0.95);
+  summary->place_bytes = system.PlaceRecognitionBytes();
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   summary->peak_rss_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;

@@ -54,6 +54,13 @@ struct RunSummary {
   int alignments_rejected = 0;
   double optimisation_ms_p50 = 0.0, optimisation_ms_p95 = 0.0;
   std::size_t graph_bytes = 0;  ///< memory held by the finished keyframes
+  /// Place recognition: database candidates, consistent ones verified, rejected, closed.
+  int loop_candidates = 0;
+  int loop_checks = 0;
+  int loops_rejected = 0;
+  int loops_closed = 0;
+  double loop_ms_p50 = 0.0, loop_ms_p95 = 0.0;
+  std::size_t place_bytes = 0;  ///< ORB features and vectors of the keyframes
 };
 
 /// Reads the dataset, rectifies each image, runs System::ProcessFrame, and writes

@@ -13,5 +13,6 @@ void AddInfoCommand(CLI::App& app, int* exit_code);
 void AddPosegraphCommand(CLI::App& app, int* exit_code);
 void AddRunCommand(CLI::App& app, int* exit_code);
 void AddSynthCommand(CLI::App& app, int* exit_code);
+void AddVocabularyCommand(CLI::App& app, int* exit_code);
 
 }  // namespace parallax::cli

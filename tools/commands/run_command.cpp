@@ -44,16 +44,17 @@ void AddRunCommand(CLI::App& app, int* exit_code) {
   cmd->add_option("--trajectory-format", *trajectory_format,
                   "trajectory files as tum, or kitti (+ <name>.times.txt)")
       ->check(CLI::IsMember({"tum", "kitti"}));
-  // Accepted so that scripts written against design.md section 5 run today: there is no loop
-  // closure yet, so every run already is one without it.
-  cmd->add_flag("--no-loop-closure")->description("disable loop closure (no effect yet)");
-  cmd->callback([options, format, realtime, config, trajectory_format, exit_code] {
+  auto no_loop_closure = std::make_shared<bool>(false);
+  cmd->add_flag("--no-loop-closure", *no_loop_closure,
+                "disable place recognition and loop closure (on by default)");
+  cmd->callback([options, format, realtime, config, trajectory_format, no_loop_closure, exit_code] {
     options->trajectory_format = *trajectory_format == "kitti"
                                      ? RunOptions::TrajectoryFormat::kKitti
                                      : RunOptions::TrajectoryFormat::kTum;
     if (*realtime)
       throw std::invalid_argument("--realtime is not implemented yet; the deterministic mode runs");
     for (const std::string& file : *config) ApplyConfigYaml(file, &options->system);
+    if (*no_loop_closure) options->system.loop_closure.enabled = false;
     options->dataset_options.format = DatasetFormatFromString(*format);
     options->progress = isatty(STDERR_FILENO) != 0;
     options->stop = &g_stop_requested;

@@ -62,13 +62,18 @@ cv::Mat DecodeGrey(const std::string& path) {
 }  // namespace
 
 ImageU8 ReadGreyImage(const std::string& path, int expected_width, int expected_height) {
-  const cv::Mat grey = DecodeGrey(path);
-  if (grey.cols != expected_width || grey.rows != expected_height) {
-    throw InputError(path, "image is " + std::to_string(grey.cols) + "x" +
-                               std::to_string(grey.rows) + " but the camera is " +
+  ImageU8 image = ReadGreyImage(path);
+  if (image.Width() != expected_width || image.Height() != expected_height) {
+    throw InputError(path, "image is " + std::to_string(image.Width()) + "x" +
+                               std::to_string(image.Height()) + " but the camera is " +
                                std::to_string(expected_width) + "x" +
                                std::to_string(expected_height));
   }
+  return image;
+}
+
+ImageU8 ReadGreyImage(const std::string& path) {
+  const cv::Mat grey = DecodeGrey(path);
   ImageU8 image(grey.cols, grey.rows);
   for (int y = 0; y < grey.rows; ++y) {
     std::copy(grey.ptr<std::uint8_t>(y), grey.ptr<std::uint8_t>(y) + grey.cols, image.Row(y));

@@ -31,6 +31,8 @@ void CheckTimestampsIncrease(const std::vector<ImageEntry>& entries);
 /// Reads an image file as 8-bit grey (colour converted with OpenCV's BT.601 weights) and
 /// checks its size. Throws InputError naming the file.
 ImageU8 ReadGreyImage(const std::string& path, int expected_width, int expected_height);
+/// The same without a size check.
+ImageU8 ReadGreyImage(const std::string& path);
 
 /// Width and height of an image file; throws InputError naming it if unreadable.
 std::pair<int, int> ProbeImageSize(const std::string& path);

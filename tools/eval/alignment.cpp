@@ -1,9 +1,10 @@
 #include "tools/eval/alignment.hpp"
 
 #include <Eigen/Geometry>
-#include <Eigen/SVD>
 #include <cmath>
 #include <stdexcept>
+
+#include "core/similarity_fit.hpp"
 
 namespace parallax {
 
@@ -54,38 +55,18 @@ Sim3d AlignUmeyama(const std::vector<Eigen::Vector3d>& x, const std::vector<Eige
     throw std::invalid_argument("alignment needs at least 3 associated poses, got " +
                                 std::to_string(n));
   }
-  Eigen::Vector3d mu_x = Eigen::Vector3d::Zero();
-  Eigen::Vector3d mu_y = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < n; ++i) {
-    mu_x += x[i];
-    mu_y += y[i];
-  }
-  mu_x /= static_cast<double>(n);
-  mu_y /= static_cast<double>(n);
-  double sigma_x2 = 0.0;
-  Eigen::Matrix3d sigma_xy = Eigen::Matrix3d::Zero();
-  for (std::size_t i = 0; i < n; ++i) {
-    sigma_x2 += (x[i] - mu_x).squaredNorm();
-    sigma_xy += (y[i] - mu_y) * (x[i] - mu_x).transpose();
-  }
-  sigma_x2 /= static_cast<double>(n);
-  sigma_xy /= static_cast<double>(n);
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(sigma_xy, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Eigen::Vector3d d = svd.singularValues();
-  const bool collinear = d[1] < 1e-10 * d[0];
+  const UmeyamaFit fit = FitUmeyama(x, y);
+  const bool collinear = !fit.WellConditioned();
   const bool oriented = R_x.size() == x.size() && R_y.size() == x.size();
-  if (!(sigma_x2 > 0.0) || !(d[0] > 0.0) || (collinear && !oriented)) {
+  if (!(fit.sigma_x2 > 0.0) || !(fit.singular_values[0] > 0.0) || (collinear && !oriented)) {
     throw std::invalid_argument(
         "alignment is degenerate: the associated positions are (nearly) collinear or constant");
   }
-  Eigen::Matrix3d S = Eigen::Matrix3d::Identity();
-  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0.0) S(2, 2) = -1.0;
-  Eigen::Matrix3d R = svd.matrixU() * S * svd.matrixV().transpose();
   // R maps the estimate's line onto the ground truth's (first singular vectors); any turn
   // about that line fits the positions equally, and keeps the scale tr(D S) / sigma_x^2.
-  if (collinear) R = TurnAboutLine(R, svd.matrixU().col(0), R_x, R_y);
-  const double s = mode == AlignmentMode::kSim3 ? (d.asDiagonal() * S).trace() / sigma_x2 : 1.0;
-  return Sim3d(s, SO3d(R), mu_y - s * R * mu_x);
+  const Eigen::Matrix3d R = collinear ? TurnAboutLine(fit.R, fit.U.col(0), R_x, R_y) : fit.R;
+  const double s = mode == AlignmentMode::kSim3 ? fit.scale : 1.0;
+  return Sim3d(s, SO3d(R), fit.mu_y - s * R * fit.mu_x);
 }
 
 }  // namespace parallax
