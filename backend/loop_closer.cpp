@@ -87,10 +87,10 @@ std::vector<DatabaseMatch> LoopCloser::KeepConsistent(
     std::set<std::int64_t> group = ConnectedKeyframes(graph, c.keyframe_id);
     group.insert(c.keyframe_id);
     int seen = 1;
-    for (const auto& [previous, count] : groups_) {
+    for (const auto& previous : groups_) {
       const bool shares = std::any_of(group.begin(), group.end(),
-                                      [&](std::int64_t k) { return previous.count(k) > 0; });
-      if (shares) seen = std::max(seen, count + 1);
+                                      [&](std::int64_t k) { return previous.first.count(k) > 0; });
+      if (shares) seen = std::max(seen, previous.second + 1);
     }
     if (seen >= options_.consistency) consistent.push_back(c);
     groups.emplace_back(std::move(group), seen);

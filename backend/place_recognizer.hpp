@@ -43,7 +43,8 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> MatchByNodes(
 class PlaceRecognizer {
  public:
   /// `vocabulary` must outlive the recogniser.
-  PlaceRecognizer(const Vocabulary& vocabulary, const PlaceRecognitionOptions& options = {});
+  explicit PlaceRecognizer(const Vocabulary& vocabulary,
+                           const PlaceRecognitionOptions& options = {});
 
   /// Features and vectors of an image (not stored).
   std::shared_ptr<const PlaceEntry> Describe(const ImageU8& image) const;

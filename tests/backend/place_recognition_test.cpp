@@ -26,6 +26,7 @@ std::vector<std::vector<OrbDescriptor>> ClusteredImages(int images, int per_imag
                                                         std::uint64_t seed) {
   std::mt19937_64 random(seed);
   std::vector<OrbDescriptor> prototypes;
+  prototypes.reserve(static_cast<std::size_t>(centres));
   for (int c = 0; c < centres; ++c) prototypes.push_back(RandomDescriptor(&random));
   std::vector<std::vector<OrbDescriptor>> out(static_cast<std::size_t>(images));
   for (auto& image : out) {
@@ -201,6 +202,7 @@ TEST_F(PlaceRecognizerTest, MatchesByNodesAgreeWithTheImageMotion) {
   EXPECT_GT(consistent, 0.9 * static_cast<double>(matches.size()));
   // Each feature of b is used at most once.
   std::vector<std::uint32_t> used;
+  used.reserve(matches.size());
   for (const auto& m : matches) used.push_back(m.second);
   std::sort(used.begin(), used.end());
   EXPECT_EQ(std::adjacent_find(used.begin(), used.end()), used.end());

@@ -41,6 +41,7 @@ BENCHMARK(BM_VocabularyTransformPerKeyframe)->Unit(benchmark::kMillisecond);
 void BM_DatabaseQuery(benchmark::State& state) {
   const auto keyframes = static_cast<int>(state.range(0));
   std::vector<std::vector<OrbDescriptor>> views;
+  views.reserve(40);
   for (int v = 0; v < 40; ++v) views.push_back(ExtractOrb(View(v / 40.0)).descriptors);
   std::mt19937_64 random(1);
   KeyframeDatabase database;
