@@ -191,9 +191,11 @@ std::optional<GraphBackend::Alignment> LoopCloser::Verify(const KeyframeGraph& g
   }
   const double correction = CorrectionPerPath(graph, candidate, id, a.S_a_b);
   if (!(correction <= options_.max_correction_per_path)) {
-    report->rejections.push_back(name + "the correction is " +
-                                 std::to_string(static_cast<int>(100.0 * correction)) +
-                                 "% of the path between the keyframes");
+    report->rejections.push_back(
+        name + "the correction is " +
+        (std::isfinite(correction) ? std::to_string(std::lround(100.0 * std::min(correction, 1e6)))
+                                   : std::string("unbounded")) +
+        "% of the path between the keyframes");
     return std::nullopt;
   }
   GraphBackend::Alignment loop = a;
