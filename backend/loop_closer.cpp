@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "backend/keypoint_depth.hpp"
 #include "core/check.hpp"
 
 namespace parallax {
@@ -39,28 +40,22 @@ std::set<std::int64_t> ConnectedKeyframes(const KeyframeGraph& graph, std::int64
   return connected;
 }
 
-LoopCloser::LoopCloser(const LoopClosureOptions& options, const Vocabulary& vocabulary,
+LoopCloser::LoopCloser(const LoopClosureOptions& options, const PlaceRecognizer* recognizer,
                        const PinholeCamera& camera)
-    : options_(options),
-      camera_(camera),
-      recognizer_(vocabulary, options.place),
-      optimizer_(options.optimizer) {
+    : options_(options), camera_(camera), recognizer_(recognizer), optimizer_(options.optimizer) {
   options_.Check();
 }
 
-void LoopCloser::Clear() {
-  recognizer_.Clear();
-  groups_.clear();
-}
+void LoopCloser::Clear() { groups_.clear(); }
 
 std::vector<DatabaseMatch> LoopCloser::Candidates(const KeyframeGraph& graph, std::int64_t id,
                                                   LoopReport* report) const {
   const std::set<std::int64_t> connected = ConnectedKeyframes(graph, id);
-  const BowVector& bow = recognizer_.Entry(id).bow;
+  const BowVector& bow = recognizer_->Entry(id).bow;
   double min_score = 1.0;
   for (const std::int64_t other : connected) {
-    if (recognizer_.Contains(other)) {
-      min_score = std::min(min_score, ScoreL1(bow, recognizer_.Entry(other).bow));
+    if (recognizer_->Contains(other)) {
+      min_score = std::min(min_score, ScoreL1(bow, recognizer_->Entry(other).bow));
     }
   }
   if (connected.empty()) min_score = 0.0;
@@ -73,7 +68,7 @@ std::vector<DatabaseMatch> LoopCloser::Candidates(const KeyframeGraph& graph, st
   const auto excluded = [&](std::int64_t other) {
     return other == id || connected.count(other) > 0 || (other >= first_recent && other <= id);
   };
-  auto matches = recognizer_.Database().Query(
+  auto matches = recognizer_->Database().Query(
       bow, excluded, static_cast<std::size_t>(options_.max_candidates), min_score);
   report->candidates = static_cast<int>(matches.size());
   return matches;
@@ -116,41 +111,20 @@ double LoopCloser::CorrectionPerPath(const KeyframeGraph& graph, std::int64_t ca
 
 std::vector<PointMatch3d> LoopCloser::LiftMatches(const KeyframeGraph& graph, std::int64_t a,
                                                   std::int64_t b) const {
-  const PlaceEntry& ea = recognizer_.Entry(a);
-  const PlaceEntry& eb = recognizer_.Entry(b);
-  ImageF idepth_a, var_a, idepth_b, var_b;
-  graph.Get(a).depth.ToImages(&idepth_a, &var_a);
-  graph.Get(b).depth.ToImages(&idepth_b, &var_b);
-  // The point of the keyframe's most certain estimate within one pixel of the keypoint.
-  const auto lift = [&](const ImageF& idepth, const ImageF& var, const Eigen::Vector2f& px,
-                        Eigen::Vector3d* p) {
-    const int cx = static_cast<int>(std::lround(px.x()));
-    const int cy = static_cast<int>(std::lround(px.y()));
-    float best_var = std::numeric_limits<float>::max();
-    float best_idepth = 0.0f;
-    for (int y = cy - 1; y <= cy + 1; ++y) {
-      for (int x = cx - 1; x <= cx + 1; ++x) {
-        if (!idepth.Contains(x, y) || !(idepth(x, y) > 0.0f) || var(x, y) >= best_var) continue;
-        best_var = var(x, y);
-        best_idepth = idepth(x, y);
-      }
-    }
-    if (!(best_idepth > 0.0f) ||
-        std::sqrt(best_var) / best_idepth > options_.max_relative_depth_std) {
-      return false;
-    }
-    *p = camera_.Unproject(px.cast<double>()) / static_cast<double>(best_idepth);
-    return true;
-  };
+  const PlaceEntry& ea = recognizer_->Entry(a);
+  const PlaceEntry& eb = recognizer_->Entry(b);
+  const KeypointDepth depth_a(graph.Get(a).depth, camera_, options_.max_relative_depth_std);
+  const KeypointDepth depth_b(graph.Get(b).depth, camera_, options_.max_relative_depth_std);
   std::vector<PointMatch3d> lifted;
   for (const auto& [i, j] : MatchByNodes(ea, eb, options_.place)) {
+    const auto p_a = depth_a.Point(ea.features.pixel[i]);
+    const auto p_b = depth_b.Point(eb.features.pixel[j]);
+    if (!p_a || !p_b) continue;
     PointMatch3d m;
+    m.p_a = *p_a;
+    m.p_b = *p_b;
     m.px_a = ea.features.pixel[i].cast<double>();
     m.px_b = eb.features.pixel[j].cast<double>();
-    if (!lift(idepth_a, var_a, ea.features.pixel[i], &m.p_a) ||
-        !lift(idepth_b, var_b, eb.features.pixel[j], &m.p_b)) {
-      continue;
-    }
     m.sigma_a = OctaveScale(options_.place.orb, ea.features.octave[i]);
     m.sigma_b = OctaveScale(options_.place.orb, eb.features.octave[j]);
     lifted.push_back(m);
@@ -209,9 +183,7 @@ std::optional<GraphBackend::Alignment> LoopCloser::Verify(const KeyframeGraph& g
 LoopReport LoopCloser::KeyframeFinished(KeyframeGraph* graph, GraphBackend* backend,
                                         std::int64_t id) {
   LoopReport report;
-  if (!options_.enabled) return report;
-  if (recognizer_.Contains(id)) return report;  // refined again: its image did not change
-  recognizer_.Add(id, recognizer_.Describe(graph->Get(id).image));
+  if (!options_.enabled || !recognizer_->Contains(id)) return report;
   const auto consistent = KeepConsistent(*graph, Candidates(*graph, id, &report));
   report.consistent = static_cast<int>(consistent.size());
   for (const DatabaseMatch& candidate : consistent) {

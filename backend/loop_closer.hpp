@@ -77,16 +77,14 @@ struct LoopReport {
 
 class LoopCloser {
  public:
-  /// `vocabulary` must outlive the closer.
-  LoopCloser(const LoopClosureOptions& options, const Vocabulary& vocabulary,
+  /// `recognizer` (the keyframes' place-recognition data) must outlive the closer.
+  LoopCloser(const LoopClosureOptions& options, const PlaceRecognizer* recognizer,
              const PinholeCamera& camera);
 
-  /// Keyframe `id` was finished and its constraints searched: describe it, look for a loop
-  /// (adding the loop edge and optimising on success), then add it to the database.
-  /// A keyframe already described (refined again) is only re-added.
+  /// Keyframe `id` was finished, its constraints searched and its place-recognition entry
+  /// added: look for a loop, adding the loop edge and optimising on success.
   LoopReport KeyframeFinished(KeyframeGraph* graph, GraphBackend* backend, std::int64_t id);
 
-  const PlaceRecognizer& Recognizer() const { return recognizer_; }
   void Clear();
 
  private:
@@ -107,7 +105,7 @@ class LoopCloser {
 
   LoopClosureOptions options_;
   PinholeCamera camera_;
-  PlaceRecognizer recognizer_;
+  const PlaceRecognizer* recognizer_;
   PoseGraphOptimizer optimizer_;
   /// Groups (candidate + its connected keyframes) seen by the previous keyframe, with the
   /// number of consecutive keyframes that saw each.

@@ -26,6 +26,7 @@ void SystemOptions::Check() const {
   quality.Check();
   backend.Check();
   loop_closure.Check();
+  relocalization.Check();
   CheckOption(bootstrap_max_frames >= 1, "SystemOptions", "bootstrap_max_frames", "must be >= 1");
   CheckOption(auto_max_rotation_deg > 0.0, "SystemOptions", "auto_max_rotation_deg", "must be > 0");
   CheckOption(auto_max_direction_deg > 0.0, "SystemOptions", "auto_max_direction_deg",
@@ -56,7 +57,9 @@ System::System(const PinholeCamera& camera, const SystemOptions& options)
       mapper_(camera, options.depth, options.update_direction, options.reference,
               options.recent_keyframes),
       backend_(options.backend, KeyframeBuildOptions{camera, options.pyramid, options.reference}),
-      loop_closer_(options.loop_closure, Vocabulary::Default(), camera) {
+      place_(Vocabulary::Default(), options.loop_closure.place),
+      loop_closer_(options.loop_closure, &place_, camera),
+      relocalizer_(options.relocalization, camera) {
   options_.Check();
 }
 
@@ -111,12 +114,14 @@ void System::FinishCurrentKeyframe(FrameResult* result) {
     backend_stats_.optimisation_ms.push_back(MillisecondsSince(start));
     result->events.push_back({SystemEvent::Kind::kGraphOptimised, result_frame_id_, keyframe->id});
   }
-  CloseLoops(keyframe->id, result);
+  RecognisePlace(keyframe->id, result);
 }
 
-void System::CloseLoops(std::int64_t id, FrameResult* result) {
-  if (!options_.loop_closure.enabled) return;
+void System::RecognisePlace(std::int64_t id, FrameResult* result) {
+  if (!options_.loop_closure.enabled && !options_.relocalization.enabled) return;
+  if (place_.Contains(id)) return;  // refined again: its image did not change
   const auto start = Clock::now();
+  place_.Add(id, place_.Describe(graph_.Get(id).image));
   const LoopReport loop = loop_closer_.KeyframeFinished(&graph_, &backend_, id);
   backend_stats_.loop_candidates += loop.candidates;
   backend_stats_.loop_checks += loop.consistent;
@@ -170,6 +175,7 @@ void System::Record(std::int64_t frame_id, const FrameResult& result) {
 
 void System::ClearMap() {
   graph_.Clear();
+  place_.Clear();
   loop_closer_.Clear();
   mapper_.Clear();
   current_ = CurrentKeyframe{};
@@ -220,6 +226,17 @@ FrameResult System::Process(const std::shared_ptr<const Frame>& frame, const Ima
       result.stats.reason = "recovered on a recent keyframe";
       SetPose(&result, tracked.T_kf_frame);
       result.events.push_back({SystemEvent::Kind::kRecovered, frame->Id(), current_.id});
+    } else if (auto relocalised = Relocalise(*frame, image)) {
+      tracked = std::move(relocalised->second);
+      result.status = tracked.status;
+      result.stats = tracked.stats;
+      result.stats.reason = "relocalised";
+      ReturnToKeyframe(Materialize(graph_.GetPtr(relocalised->first), camera_, options_.pyramid,
+                                   options_.reference),
+                       &result);
+      tracker_.SetState(MotionState{tracked.T_kf_frame, SE3d(), tracked.affine, 1});
+      SetPose(&result, tracked.T_kf_frame);
+      result.events.push_back({SystemEvent::Kind::kRelocalised, frame->Id(), current_.id});
     }
   }
   if (start_ != StartState::kInitialised) {
@@ -308,6 +325,52 @@ std::optional<TrackingResult> System::TrackRecentKeyframes(const Frame& frame,
   current_ = CurrentKeyframe{id, std::nullopt, Sim3d()};
   CompactOldKeyframes();
   return std::move(found->second);
+}
+
+std::optional<std::pair<std::int64_t, TrackingResult>> System::Relocalise(const Frame& frame,
+                                                                          const ImageU8& image) {
+  if (!options_.relocalization.enabled || place_.Size() == 0) return std::nullopt;
+  ++backend_stats_.relocalisation_attempts;
+  const auto entry = place_.Describe(image);
+  for (const RelocalizationGuess& guess : relocalizer_.Propose(graph_, place_, *entry)) {
+    const auto keyframe = Materialize(graph_.GetPtr(guess.keyframe_id), camera_, options_.pyramid,
+                                      options_.reference);
+    TrackingResult r =
+        tracker_.TrackFrom(*keyframe->reference, frame, guess.T_kf_frame, AffineBrightness{});
+    if (r.status != TrackingStatus::kOk) continue;
+    ++backend_stats_.relocalisations;
+    return std::make_pair(guess.keyframe_id, std::move(r));
+  }
+  return std::nullopt;
+}
+
+void System::ReturnToKeyframe(const std::shared_ptr<const Keyframe>& keyframe,
+                              FrameResult* result) {
+  if (keyframe->id == current_.id) return;
+  FinishCurrentKeyframe(result);
+  std::optional<std::size_t> recent;
+  for (std::size_t i = 0; i < mapper_.NumRecent(); ++i) {
+    if (mapper_.RecentKeyframeId(i) == keyframe->id) recent = i;
+  }
+  if (recent) {
+    mapper_.ReturnTo(*recent);
+  } else {
+    // Its map again from the frozen depth; hypotheses stay unconfirmed.
+    InverseDepthMap map(keyframe->frame, options_.depth);
+    ImageF idepth, variance;
+    keyframe->depth.ToImages(&idepth, &variance);
+    map.InitializeFromPrior(idepth, variance);
+    for (std::size_t k = 0; k < keyframe->depth.Size(); ++k) {
+      if (!keyframe->depth.confirmed[k]) {
+        map.observations[static_cast<std::size_t>(keyframe->depth.pixel[k])] = 0;
+      }
+    }
+    mapper_.Retire();
+    mapper_.SetMap(std::move(map));
+    mapper_.Direction().Reset();
+  }
+  current_ = CurrentKeyframe{keyframe->id, std::nullopt, Sim3d()};
+  CompactOldKeyframes();
 }
 
 std::vector<Eigen::Vector3f> System::MapPoints() const {

@@ -14,6 +14,8 @@
 #include "backend/keyframe_graph.hpp"
 #include "backend/loop_closer.hpp"
 #include "backend/mapper.hpp"
+#include "backend/place_recognizer.hpp"
+#include "backend/relocalizer.hpp"
 #include "backend/two_view_bootstrap.hpp"
 #include "backend/update_direction.hpp"
 #include "core/frame.hpp"
@@ -99,6 +101,9 @@ struct SystemOptions {
   GraphBackendOptions backend;
   /// Place recognition and loop closure on finished keyframes (needs optimize_graph).
   LoopClosureOptions loop_closure;
+  /// A frame lost against the current and recent keyframes is relocalised on the keyframe
+  /// database (place recognition data is kept for it even without loop closure).
+  RelocalizationOptions relocalization;
 
   void Check() const;
 };
@@ -124,6 +129,7 @@ struct SystemEvent {
     kPosesRevised,      ///< earlier frames' poses revised or withdrawn (initialisation)
     kRestarted,         ///< the start failed and began again at this frame
     kLoopClosed,        ///< keyframe_id closed a loop with loop_keyframe_id; graph optimised
+    kRelocalised,       ///< lost beyond the recent keyframes, found again on keyframe_id
   };
   Kind kind = Kind::kLost;
   std::int64_t frame_id = 0;
@@ -156,7 +162,9 @@ struct BackendStats {
   int loop_checks = 0;      ///< consistent candidates verified geometrically
   int loops_rejected = 0;   ///< of them, failed verification
   int loops_closed = 0;
-  std::vector<double> loop_ms;  ///< place recognition per finished keyframe
+  std::vector<double> loop_ms;      ///< place recognition per finished keyframe
+  int relocalisation_attempts = 0;  ///< frames lost beyond the recent keyframes
+  int relocalisations = 0;
 };
 
 /// Per-frame outcome.
@@ -205,7 +213,7 @@ class System {
   const KeyframeGraph& Graph() const { return graph_; }
   const BackendStats& Backend() const { return backend_stats_; }
   /// Memory held by place recognition (keyframe features and vectors).
-  std::size_t PlaceRecognitionBytes() const { return loop_closer_.Recognizer().Bytes(); }
+  std::size_t PlaceRecognitionBytes() const { return place_.Bytes(); }
   int FramesProcessed() const { return frame_count_; }
   /// Frames rejected by the quality gate (SystemOptions::quality).
   int FramesUnusable() const { return frames_unusable_; }
@@ -218,8 +226,17 @@ class System {
                      InverseDepthMap map, FrameResult* result);
   /// Freezes the current keyframe into the graph and runs the backend on it.
   void FinishCurrentKeyframe(FrameResult* result);
-  /// Place recognition for the finished keyframe `id`; a verified loop becomes an edge.
-  void CloseLoops(std::int64_t id, FrameResult* result);
+  /// Place recognition for the finished keyframe `id` (its entry in the database); a
+  /// verified loop becomes an edge.
+  void RecognisePlace(std::int64_t id, FrameResult* result);
+  /// For a frame lost against the current and recent keyframes: database candidates, PnP on
+  /// their depth, direct confirmation; the keyframe found becomes current.
+  /// Returns the keyframe found and the frame tracked on it.
+  std::optional<std::pair<std::int64_t, TrackingResult>> Relocalise(const Frame& frame,
+                                                                    const ImageU8& image);
+  /// Makes keyframe `keyframe` (in the graph) current again: the current one is finished;
+  /// its mutable map comes from the recent ones or is rebuilt from its frozen depth.
+  void ReturnToKeyframe(const std::shared_ptr<const Keyframe>& keyframe, FrameResult* result);
   /// Keyframe-to-world pose of the current keyframe (through its parent while unfinished).
   Sim3d CurrentKeyframePose() const;
   Sim3d KeyframePose(std::int64_t id) const;
@@ -294,7 +311,9 @@ class System {
   FrameTracker tracker_;
   Mapper mapper_;
   GraphBackend backend_;
+  PlaceRecognizer place_;  ///< before loop_closer_, which keeps a pointer to it
   LoopCloser loop_closer_;
+  Relocalizer relocalizer_;
   BackendStats backend_stats_;
   /// Finished keyframes and their poses (the map).
   KeyframeGraph graph_;

@@ -114,6 +114,15 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"ransac_max_iterations", Set(&o->loop_closure.ransac.max_iterations)},
         {"ransac_max_reprojection_chi2", Set(&o->loop_closure.ransac.max_reprojection_chi2)},
         {"optimizer_max_iterations", Set(&o->loop_closure.optimizer.max_iterations)}}},
+      {"relocalization",
+       {{"enabled", Set(&o->relocalization.enabled)},
+        {"max_candidates", Set(&o->relocalization.max_candidates)},
+        {"min_score", Set(&o->relocalization.min_score)},
+        {"min_matches", Set(&o->relocalization.min_matches)},
+        {"min_inliers", Set(&o->relocalization.min_inliers)},
+        {"max_reprojection_px", Set(&o->relocalization.max_reprojection_px)},
+        {"ransac_iterations", Set(&o->relocalization.ransac_iterations)},
+        {"max_relative_depth_std", Set(&o->relocalization.max_relative_depth_std)}}},
   };
 }
 
@@ -136,10 +145,10 @@ void ApplyConfigYaml(const std::string& path, SystemOptions* options) {
     const std::string name = section.first.as<std::string>();
     const auto found = sections.find(name);
     if (found == sections.end()) {
-      throw InputError(
-          path, LineOf(section.first),
-          "unknown section '" + name +
-              "' (expected pyramid, reference, tracker, depth, system, backend or loop_closure)");
+      throw InputError(path, LineOf(section.first),
+                       "unknown section '" + name +
+                           "' (expected pyramid, reference, tracker, depth, system, backend, "
+                           "loop_closure or relocalization)");
     }
     if (!section.second.IsMap())
       throw InputError(path, LineOf(section.second), "section '" + name + "' must be a mapping");

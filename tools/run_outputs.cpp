@@ -82,7 +82,8 @@ void WriteStats(const std::string& path, const RunSummary& s) {
         {"loops_closed", s.loops_closed},
         {"ms_per_keyframe", {{"p50", s.loop_ms_p50}, {"p95", s.loop_ms_p95}}},
         {"bytes", s.place_bytes}}},
-      {"relocalisations", 0},
+      {"relocalisations", s.relocalisations},
+      {"relocalisation_attempts", s.relocalisation_attempts},
       {"initialised_at_frame", s.initialised_at_frame},
       {"wall_s", s.wall_s},
       {"fps", s.fps},
@@ -123,6 +124,9 @@ std::string EventNames(const std::vector<SystemEvent>& events) {
         break;
       case SystemEvent::Kind::kLoopClosed:
         names += "loop:" + std::to_string(e.loop_keyframe_id);
+        break;
+      case SystemEvent::Kind::kRelocalised:
+        names += "relocalised:" + std::to_string(e.keyframe_id);
         break;
     }
   }

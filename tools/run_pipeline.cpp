@@ -65,6 +65,8 @@ void Summarise(const System& system, const std::vector<double>& tracking_ms,
   summary->loop_ms_p50 = Percentile(system.Backend().loop_ms, 0.5);
   summary->loop_ms_p95 = Percentile(system.Backend().loop_ms, 0.95);
   summary->place_bytes = system.PlaceRecognitionBytes();
+  summary->relocalisations = system.Backend().relocalisations;
+  summary->relocalisation_attempts = system.Backend().relocalisation_attempts;
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   summary->peak_rss_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;

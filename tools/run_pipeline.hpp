@@ -61,6 +61,8 @@ struct RunSummary {
   int loops_closed = 0;
   double loop_ms_p50 = 0.0, loop_ms_p95 = 0.0;
   std::size_t place_bytes = 0;  ///< ORB features and vectors of the keyframes
+  int relocalisations = 0;
+  int relocalisation_attempts = 0;  ///< frames lost beyond the recent keyframes
 };
 
 /// Reads the dataset, rectifies each image, runs System::ProcessFrame, and writes
