@@ -68,7 +68,11 @@ std::vector<std::int64_t> GraphBackend::NeighbourCandidates(
   const Eigen::Vector3d axis = S_w_kf.Rotation() * Eigen::Vector3d::UnitZ();
   std::vector<std::pair<double, std::int64_t>> near;
   for (const std::int64_t other : graph.Ids()) {
-    if (other == id || other == parent || graph.HasEdge(id, other)) continue;
+    // Poses of another map are in another world frame: no distance to compare.
+    if (other == id || other == parent || graph.HasEdge(id, other) ||
+        graph.MapOf(other) != graph.MapOf(id)) {
+      continue;
+    }
     const Sim3d& S_w_other = graph.Pose(other);
     // Distance in units of the finished keyframe's mean depth (its scale in the world).
     const double distance =

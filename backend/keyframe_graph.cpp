@@ -37,10 +37,33 @@ std::size_t FrozenDepth::Bytes() const {
          variance.capacity() * sizeof(float) + confirmed.capacity();
 }
 
-void KeyframeGraph::Upsert(std::shared_ptr<const Keyframe> keyframe, const Sim3d& S_w_kf) {
+void KeyframeGraph::Upsert(std::shared_ptr<const Keyframe> keyframe, const Sim3d& S_w_kf,
+                           int map_id) {
   const std::int64_t id = keyframe->id;
-  if (!Contains(id)) poses_.SetVertex(id, S_w_kf, keyframes_.empty());
+  if (!Contains(id)) {
+    const bool first_of_map = std::none_of(
+        map_of_.begin(), map_of_.end(), [&](const auto& entry) { return entry.second == map_id; });
+    poses_.SetVertex(id, S_w_kf, first_of_map);
+    map_of_[id] = map_id;
+  }
   keyframes_[id] = std::move(keyframe);
+}
+
+int KeyframeGraph::NumMaps() const {
+  std::vector<int> maps;
+  for (const auto& [id, map] : map_of_) {
+    if (std::find(maps.begin(), maps.end(), map) == maps.end()) maps.push_back(map);
+  }
+  return static_cast<int>(maps.size());
+}
+
+void KeyframeGraph::MergeMaps(int from, int into, const Sim3d& S_into_from) {
+  for (auto& [id, map] : map_of_) {
+    if (map != from) continue;
+    poses_.SetPose(id, S_into_from * poses_.Pose(id));
+    poses_.SetFixed(id, false);
+    map = into;
+  }
 }
 
 bool KeyframeGraph::HasEdge(std::int64_t a, std::int64_t b) const {
@@ -127,6 +150,7 @@ std::size_t KeyframeGraph::Bytes() const {
 
 void KeyframeGraph::Clear() {
   keyframes_.clear();
+  map_of_.clear();
   poses_ = PoseGraph();
 }
 

@@ -72,10 +72,18 @@ struct EdgeCounts {
 /// Owns the finished keyframes and the Sim(3) pose graph over them.
 class KeyframeGraph {
  public:
-  /// Adds a finished keyframe at pose S_w_kf, or replaces the data of one already in the
-  /// graph (its optimised pose is kept; S_w_kf is then ignored). The first keyframe added is
-  /// the gauge (fixed in optimisation).
-  void Upsert(std::shared_ptr<const Keyframe> keyframe, const Sim3d& S_w_kf);
+  /// Adds a finished keyframe of map `map_id` at pose S_w_kf (in that map's world), or
+  /// replaces the data of one already in the graph (its optimised pose and map are kept;
+  /// S_w_kf and map_id are then ignored). The first keyframe of a map is its gauge (fixed
+  /// in optimisation) until the map is merged into another.
+  void Upsert(std::shared_ptr<const Keyframe> keyframe, const Sim3d& S_w_kf, int map_id = 0);
+  /// The map (connected component, with its own world frame) keyframe `id` belongs to.
+  int MapOf(std::int64_t id) const { return map_of_.at(id); }
+  /// Distinct maps with at least one keyframe.
+  int NumMaps() const;
+  /// Moves every keyframe of map `from` into map `into`: S_w_k <- S_into_from * S_w_k; its
+  /// gauge is released (the merged graph keeps `into`'s).
+  void MergeMaps(int from, int into, const Sim3d& S_into_from);
   bool Contains(std::int64_t id) const { return keyframes_.count(id) > 0; }
   /// Throws std::out_of_range for an unknown id.
   const Keyframe& Get(std::int64_t id) const { return *keyframes_.at(id); }
@@ -108,6 +116,7 @@ class KeyframeGraph {
 
  private:
   std::map<std::int64_t, std::shared_ptr<const Keyframe>> keyframes_;
+  std::map<std::int64_t, int> map_of_;
   PoseGraph poses_;
 };
 

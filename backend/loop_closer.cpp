@@ -163,7 +163,9 @@ std::optional<GraphBackend::Alignment> LoopCloser::Verify(const KeyframeGraph& g
     report->rejections.push_back(name + "the two directions of the direct alignment disagree");
     return std::nullopt;
   }
-  const double correction = CorrectionPerPath(graph, candidate, id, a.S_a_b);
+  // Between two maps there is no path and no drift to bound: the other gates decide.
+  const bool same_map = graph.MapOf(candidate) == graph.MapOf(id);
+  const double correction = same_map ? CorrectionPerPath(graph, candidate, id, a.S_a_b) : 0.0;
   if (!(correction <= options_.max_correction_per_path)) {
     report->rejections.push_back(
         name + "the correction is " +
@@ -191,6 +193,16 @@ LoopReport LoopCloser::KeyframeFinished(KeyframeGraph* graph, GraphBackend* back
     if (!loop) {
       ++report.rejected;
       continue;
+    }
+    const int map = graph->MapOf(id);
+    const int candidate_map = graph->MapOf(candidate.keyframe_id);
+    if (map != candidate_map) {
+      // The new keyframe's map moves into the candidate's world: S_wA_new = S_wA_cand *
+      // S_cand_new, so S_A_B = S_wA_cand * S_cand_new * S_wB_new^-1.
+      const Sim3d S_A_B =
+          graph->Pose(candidate.keyframe_id) * loop->S_a_b * graph->Pose(id).Inverse();
+      graph->MergeMaps(map, candidate_map, S_A_B);
+      report.merged_map = map;
     }
     graph->AddEdge(
         PoseGraphEdge{candidate.keyframe_id, id, loop->S_a_b, loop->information, EdgeKind::kLoop});

@@ -48,7 +48,8 @@ struct LoopClosureOptions {
   double max_reciprocal_translation = 0.05;
   double max_reciprocal_rotation_deg = 2.0;
   double max_reciprocal_log_scale = 0.05;
-  /// Drift bound: the loop may move the new keyframe (relative to the candidate) by at most
+  /// Drift bound (within one map; a loop between two maps merges them instead): the loop
+  /// may move the new keyframe (relative to the candidate) by at most
   /// this share of the path travelled between them. Visual odometry drifts by a few percent
   /// of the path; a repeated texture "recognised" further along a corridor claims a
   /// correction as long as the path itself (measured: 100% on the corridor walk).
@@ -70,6 +71,9 @@ struct LoopReport {
   int consistent = 0;  ///< of them, consistent over consecutive keyframes (verified)
   int rejected = 0;    ///< verified and rejected (matches, RANSAC or direct alignment)
   std::optional<std::int64_t> loop_keyframe;  ///< the keyframe the loop closed with
+  /// The loop joined two maps: this one (the new keyframe's) was merged into the
+  /// candidate's, whose world frame it now shares.
+  std::optional<int> merged_map;
   int ransac_inliers = 0;
   std::optional<PoseGraphSummary> optimisation;
   std::vector<std::string> rejections;  ///< why each rejected candidate failed

@@ -27,6 +27,7 @@ void SystemOptions::Check() const {
   backend.Check();
   loop_closure.Check();
   relocalization.Check();
+  CheckOption(new_map_after_lost_s > 0.0, "SystemOptions", "new_map_after_lost_s", "must be > 0");
   CheckOption(bootstrap_max_frames >= 1, "SystemOptions", "bootstrap_max_frames", "must be >= 1");
   CheckOption(auto_max_rotation_deg > 0.0, "SystemOptions", "auto_max_rotation_deg", "must be > 0");
   CheckOption(auto_max_direction_deg > 0.0, "SystemOptions", "auto_max_direction_deg",
@@ -94,7 +95,7 @@ RevisedPose System::Revised(const Frame& frame, const std::optional<SE3d>& T_kf_
 void System::FinishCurrentKeyframe(FrameResult* result) {
   const std::shared_ptr<Keyframe> keyframe = mapper_.Freeze();
   const bool is_new = !graph_.Contains(keyframe->id);
-  graph_.Upsert(keyframe, CurrentKeyframePose());
+  graph_.Upsert(keyframe, CurrentKeyframePose(), current_map_);
   result->events.push_back({SystemEvent::Kind::kKeyframeFinished, result_frame_id_, keyframe->id});
   if (!options_.optimize_graph) {
     if (is_new && current_.parent) {
@@ -131,6 +132,13 @@ void System::RecognisePlace(std::int64_t id, FrameResult* result) {
     backend_stats_.iterations += loop.optimisation->iterations;
   }
   backend_stats_.loop_ms.push_back(MillisecondsSince(start));
+  if (loop.merged_map) {
+    ++backend_stats_.merges;
+    SystemEvent merged{SystemEvent::Kind::kMapsMerged, result_frame_id_, id, *loop.loop_keyframe};
+    merged.map_id = *loop.merged_map;
+    result->events.push_back(merged);
+    if (current_map_ == *loop.merged_map) current_map_ = graph_.MapOf(id);
+  }
   if (loop.loop_keyframe) {
     ++backend_stats_.loops_closed;
     result->events.push_back(
@@ -174,9 +182,13 @@ void System::Record(std::int64_t frame_id, const FrameResult& result) {
 }
 
 void System::ClearMap() {
-  graph_.Clear();
-  place_.Clear();
-  loop_closer_.Clear();
+  // A failed start of a later map keeps the earlier maps (no keyframe of the failed start
+  // was finished: initialisation completes before any keyframe is left).
+  if (current_map_ == 0) {
+    graph_.Clear();
+    place_.Clear();
+    loop_closer_.Clear();
+  }
   mapper_.Clear();
   current_ = CurrentKeyframe{};
 }
@@ -209,6 +221,7 @@ FrameResult System::ProcessFrame(const ImageU8& image, double timestamp) {
   if (!result.revised.empty()) {
     result.events.push_back({SystemEvent::Kind::kPosesRevised, frame->Id(), -1});
   }
+  if (result.T_w_c) last_posed_timestamp_ = timestamp;
   Record(frame->Id(), result);
   return result;
 }
@@ -237,6 +250,8 @@ FrameResult System::Process(const std::shared_ptr<const Frame>& frame, const Ima
       tracker_.SetState(MotionState{tracked.T_kf_frame, SE3d(), tracked.affine, 1});
       SetPose(&result, tracked.T_kf_frame);
       result.events.push_back({SystemEvent::Kind::kRelocalised, frame->Id(), current_.id});
+    } else if (frame->Timestamp() - last_posed_timestamp_ >= options_.new_map_after_lost_s) {
+      return StartNewMap(frame, image);
     }
   }
   if (start_ != StartState::kInitialised) {
@@ -370,7 +385,30 @@ void System::ReturnToKeyframe(const std::shared_ptr<const Keyframe>& keyframe,
     mapper_.Direction().Reset();
   }
   current_ = CurrentKeyframe{keyframe->id, std::nullopt, Sim3d()};
+  current_map_ = graph_.MapOf(keyframe->id);
   CompactOldKeyframes();
+}
+
+FrameResult System::StartNewMap(const std::shared_ptr<const Frame>& frame, const ImageU8& image) {
+  FrameResult finished;
+  FinishCurrentKeyframe(&finished);
+  mapper_.Clear();
+  current_ = CurrentKeyframe{};
+  current_map_ = next_map_++;
+  ++backend_stats_.maps_started;
+  start_ = StartState::kNoKeyframe;
+  depth_updates_ = 0;
+  lost_in_a_row_ = 0;
+  initial_frames_.clear();
+  bootstrap_.reset();
+  pending_pair_.reset();
+  FrameResult result = StartFirstKeyframe(frame, image);
+  SystemEvent started{SystemEvent::Kind::kNewMap, frame->Id(),
+                      result.is_keyframe ? frame->Id() : -1};
+  started.map_id = current_map_;
+  result.events.insert(result.events.begin(), started);
+  result.events.insert(result.events.begin(), finished.events.begin(), finished.events.end());
+  return result;
 }
 
 std::vector<Eigen::Vector3f> System::MapPoints() const {

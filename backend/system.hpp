@@ -104,6 +104,10 @@ struct SystemOptions {
   /// A frame lost against the current and recent keyframes is relocalised on the keyframe
   /// database (place recognition data is kept for it even without loop closure).
   RelocalizationOptions relocalization;
+  /// Recovery from long loss: once no frame has had a pose for this long (input time,
+  /// seconds) and relocalisation keeps failing, a new map is started at the next frame that
+  /// can start one; a later loop to an earlier map merges the two.
+  double new_map_after_lost_s = 2.0;
 
   void Check() const;
 };
@@ -130,11 +134,14 @@ struct SystemEvent {
     kRestarted,         ///< the start failed and began again at this frame
     kLoopClosed,        ///< keyframe_id closed a loop with loop_keyframe_id; graph optimised
     kRelocalised,       ///< lost beyond the recent keyframes, found again on keyframe_id
+    kNewMap,            ///< lost too long: map_id started (keyframe_id: its first keyframe)
+    kMapsMerged,        ///< a loop joined map_id into the map of loop_keyframe_id
   };
   Kind kind = Kind::kLost;
   std::int64_t frame_id = 0;
   std::int64_t keyframe_id = -1;
-  std::int64_t loop_keyframe_id = -1;  ///< kLoopClosed: the earlier keyframe
+  std::int64_t loop_keyframe_id = -1;  ///< kLoopClosed, kMapsMerged: the earlier keyframe
+  int map_id = -1;                     ///< kNewMap: the new map; kMapsMerged: the merged one
 };
 
 /// A frame's pose as the map holds it: relative to a keyframe, so that a correction of the
@@ -165,6 +172,8 @@ struct BackendStats {
   std::vector<double> loop_ms;      ///< place recognition per finished keyframe
   int relocalisation_attempts = 0;  ///< frames lost beyond the recent keyframes
   int relocalisations = 0;
+  int maps_started = 0;  ///< new maps after long loss (the first map not counted)
+  int merges = 0;
 };
 
 /// Per-frame outcome.
@@ -211,6 +220,8 @@ class System {
   /// Every frame that has a pose, in frame order, through its keyframe's current pose.
   std::vector<FramePose> Trajectory() const;
   const KeyframeGraph& Graph() const { return graph_; }
+  /// The map new keyframes currently join (0 until a long loss started another).
+  int CurrentMap() const { return current_map_; }
   const BackendStats& Backend() const { return backend_stats_; }
   /// Memory held by place recognition (keyframe features and vectors).
   std::size_t PlaceRecognitionBytes() const { return place_.Bytes(); }
@@ -237,6 +248,9 @@ class System {
   /// Makes keyframe `keyframe` (in the graph) current again: the current one is finished;
   /// its mutable map comes from the recent ones or is rebuilt from its frozen depth.
   void ReturnToKeyframe(const std::shared_ptr<const Keyframe>& keyframe, FrameResult* result);
+  /// Recovery from long loss: the lost map's current keyframe is finished and a new map
+  /// starts at `frame` (its own world frame until a loop merges it).
+  FrameResult StartNewMap(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
   /// Keyframe-to-world pose of the current keyframe (through its parent while unfinished).
   Sim3d CurrentKeyframePose() const;
   Sim3d KeyframePose(std::int64_t id) const;
@@ -337,6 +351,11 @@ class System {
   /// tracked again against the converged depth; the first keyframe is not among them.
   std::vector<std::pair<std::shared_ptr<const Frame>, SE3d>> initial_frames_;
   int lost_in_a_row_ = 0;
+  /// The map new keyframes join, and the id the next new map gets.
+  int current_map_ = 0;
+  int next_map_ = 1;
+  /// Timestamp of the last frame that got a pose (long-loss timer).
+  double last_posed_timestamp_ = 0.0;
   std::unique_ptr<TwoViewBootstrap> bootstrap_;  ///< set while a two-view pair is sought
   int bootstrap_tries_ = 0;
   /// Auto: the first good pair, held until the random start has converged (or failed) and

@@ -111,7 +111,7 @@ std::vector<RevisedPose> System::FinishInitialisation() {
   initial_frames_.clear();
   bootstrap_.reset();
   start_ = StartState::kInitialised;
-  initialised_at_frame_ = frame_count_ - 1;
+  if (initialised_at_frame_ < 0) initialised_at_frame_ = frame_count_ - 1;  // the first map's
   return revised;
 }
 

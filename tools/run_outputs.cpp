@@ -84,6 +84,9 @@ void WriteStats(const std::string& path, const RunSummary& s) {
         {"bytes", s.place_bytes}}},
       {"relocalisations", s.relocalisations},
       {"relocalisation_attempts", s.relocalisation_attempts},
+      {"maps", s.maps},
+      {"maps_started", s.maps_started},
+      {"merges", s.merges},
       {"initialised_at_frame", s.initialised_at_frame},
       {"wall_s", s.wall_s},
       {"fps", s.fps},
@@ -127,6 +130,12 @@ std::string EventNames(const std::vector<SystemEvent>& events) {
         break;
       case SystemEvent::Kind::kRelocalised:
         names += "relocalised:" + std::to_string(e.keyframe_id);
+        break;
+      case SystemEvent::Kind::kNewMap:
+        names += "new_map:" + std::to_string(e.map_id);
+        break;
+      case SystemEvent::Kind::kMapsMerged:
+        names += "merged:" + std::to_string(e.map_id);
         break;
     }
   }

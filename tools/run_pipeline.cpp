@@ -67,6 +67,9 @@ void Summarise(const System& system, const std::vector<double>& tracking_ms,
   summary->place_bytes = system.PlaceRecognitionBytes();
   summary->relocalisations = system.Backend().relocalisations;
   summary->relocalisation_attempts = system.Backend().relocalisation_attempts;
+  summary->maps = system.Graph().NumMaps();
+  summary->maps_started = system.Backend().maps_started;
+  summary->merges = system.Backend().merges;
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   summary->peak_rss_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;

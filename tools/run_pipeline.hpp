@@ -63,6 +63,9 @@ struct RunSummary {
   std::size_t place_bytes = 0;  ///< ORB features and vectors of the keyframes
   int relocalisations = 0;
   int relocalisation_attempts = 0;  ///< frames lost beyond the recent keyframes
+  int maps = 0;                     ///< maps in the final graph (1 when every new map was merged)
+  int maps_started = 0;             ///< new maps after long loss
+  int merges = 0;
 };
 
 /// Reads the dataset, rectifies each image, runs System::ProcessFrame, and writes
