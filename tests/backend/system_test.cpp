@@ -135,9 +135,10 @@ ImageU8 RenderRoom(const SE3d& T_start_c, float gain, double noise_sigma, std::u
 /// 60 frames of a sideways pan through the rendered room (1.2 m, 36 degrees), then a jump
 /// back to 2-8 cm from the start (as after a dropped stretch of video); returns how many of
 /// the 10 frames after the jump were tracked, checking their rotations.
-int TrackedAfterJumpBack(int recent_keyframes) {
+int TrackedAfterJumpBack(int recent_keyframes, bool relocalization = false) {
   SystemOptions options;
   options.recent_keyframes = recent_keyframes;
+  options.relocalization.enabled = relocalization;
   System system(synth::SynthCamera({}), options);
   auto render = [](const SE3d& T_start_c) { return RenderRoom(T_start_c, 1.0f, 0.0, 1); };
   auto pan = [](double i) {  // 2 cm and 0.6 degrees per frame, with a little bob
@@ -165,9 +166,11 @@ int TrackedAfterJumpBack(int recent_keyframes) {
 
 TEST(Pipeline, LostFramesAreRecoveredOnRecentKeyframes) {
   // The jump back is far outside what the motion hypotheses around the last pose reach, so
-  // only an earlier keyframe recovers it; without recent keyframes every later frame is lost.
+  // only an earlier keyframe recovers it; without recent keyframes (and without
+  // relocalisation) every later frame is lost, and relocalisation alone recovers them too.
   EXPECT_GE(TrackedAfterJumpBack(4), 9);
   EXPECT_EQ(TrackedAfterJumpBack(0), 0);
+  EXPECT_GE(TrackedAfterJumpBack(0, true), 9);
 }
 
 TEST(Pipeline, StaticCameraInventsNoMotionAndNoKeyframes) {
