@@ -27,6 +27,10 @@ class OrbitFeeder {
   explicit OrbitFeeder(const SystemOptions& options)
       : scene_(synth::MakeScene("room", 1)), system_(test::TestCamera(), options) {}
 
+  /// From now on the camera is in another room of the same shape, furnished and decorated
+  /// alike but with other textures (another seed).
+  void MoveToSimilarRoom(std::uint64_t seed) { scene_ = synth::MakeScene("room", seed); }
+
   /// Orbit position k (150 per lap, 30 frames/s; k beyond 150 goes round again).
   FrameResult View(int k, bool after_gap) {
     const SE3d T_w_c = synth::CameraPose(synth::Motion::kOrbit, scene_.rig, k / 30.0, 5.0);
@@ -128,6 +132,26 @@ TEST(Relocalisation, ACameraThatReappearsSomewhereNewStartsANewMapMergedOnItsRet
   EXPECT_EQ(before_n, 60);
   EXPECT_GE(after_n, 60);
   EXPECT_LE(after, 2.0 * before + 1e-3);
+}
+
+TEST(Relocalisation, ASimilarRoomIsNeitherRelocalisedInNorMergedWithTheFirst) {
+  SystemOptions options;
+  options.new_map_after_lost_s = 0.5;
+  OrbitFeeder feeder(options);
+  // 100 frames round the first room; 20 black frames; then the camera is in a second room of
+  // the same shape and furniture (other textures), at the views the first room's map has.
+  for (int k = 0; k < 100; ++k) feeder.View(k, false);
+  for (int k = 0; k < 20; ++k) feeder.Black();
+  feeder.MoveToSimilarRoom(2);
+  for (int k = 0; k < 100; ++k) feeder.View(k, true);
+  const BackendStats& stats = feeder.Get().Backend();
+  RecordProperty("relocalisation_attempts", stats.relocalisation_attempts);
+  RecordProperty("loop_checks", stats.loop_checks);
+  EXPECT_GT(stats.relocalisation_attempts, 0);  // it was lost and tried
+  EXPECT_EQ(stats.relocalisations, 0);
+  EXPECT_EQ(stats.maps_started, 1);
+  EXPECT_EQ(stats.merges, 0);
+  EXPECT_EQ(feeder.Get().Graph().NumMaps(), 2);
 }
 
 }  // namespace
