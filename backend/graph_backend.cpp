@@ -90,6 +90,20 @@ std::vector<std::int64_t> GraphBackend::NeighbourCandidates(
   return ids;
 }
 
+Matrix7d GraphBackend::FallbackInformation() const {
+  if (!options_.fallback_from_median || accepted_odometry_.empty()) {
+    return options_.fallback_odometry_information * Matrix7d::Identity();
+  }
+  std::vector<std::pair<double, std::size_t>> order;
+  order.reserve(accepted_odometry_.size());
+  for (std::size_t k = 0; k < accepted_odometry_.size(); ++k) {
+    order.emplace_back(accepted_odometry_[k].first, k);
+  }
+  const auto middle = order.begin() + static_cast<std::ptrdiff_t>(order.size() / 2);
+  std::nth_element(order.begin(), middle, order.end());
+  return accepted_odometry_[middle->second].second;
+}
+
 BackendReport GraphBackend::KeyframeFinished(KeyframeGraph* graph, std::int64_t id,
                                              std::optional<std::int64_t> parent,
                                              const Sim3d& S_parent_kf) {
@@ -103,9 +117,8 @@ BackendReport GraphBackend::KeyframeFinished(KeyframeGraph* graph, std::int64_t 
     // The chain's measurement is what tracking used; the alignment, when it agrees, says how
     // well it is known. A failed alignment keeps the chain with a fixed weight.
     edge.S_i_j = a.accepted && options_.odometry_from_alignment ? a.S_a_b : S_parent_kf;
-    edge.information =
-        a.accepted ? a.information
-                   : Matrix7d(options_.fallback_odometry_information * Matrix7d::Identity());
+    edge.information = a.accepted ? a.information : FallbackInformation();
+    if (a.accepted) accepted_odometry_.emplace_back(a.information.trace(), a.information);
     graph->AddEdge(edge);
     ++report.edges_added;
     report.edges_rejected += a.accepted ? 0 : 1;

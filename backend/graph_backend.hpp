@@ -31,8 +31,12 @@ struct GraphBackendOptions {
   /// unscaled, becomes chi^2(7)'s median 6.35 (docs/math/pose_graph.md).
   double information_scale = 4e-3;
   /// Information of an odometry edge whose alignment fails (the tracking chain's
-  /// measurement is kept so the graph stays connected): diagonal, per residual unit^2.
+  /// measurement is kept so the graph stays connected): the accepted odometry edge of median
+  /// trace so far, or, before any was accepted, this diagonal (per residual unit^2). A fixed
+  /// weak value made such an edge absorb a whole loop correction (a 5 cm step on the orbit,
+  /// its weight being 1e-4 of its neighbours').
   double fallback_odometry_information = 1e4;
+  bool fallback_from_median = true;
   /// true: an odometry edge measures what the keyframe alignment found; false: the tracking
   /// chain's S_parent_kf, weighted by the alignment's information.
   bool odometry_from_alignment = true;
@@ -89,8 +93,13 @@ class GraphBackend {
   std::vector<std::int64_t> NeighbourCandidates(const KeyframeGraph& graph, std::int64_t id,
                                                 std::optional<std::int64_t> parent) const;
 
+  /// The information of an odometry edge whose alignment failed (see the options).
+  Matrix7d FallbackInformation() const;
+
   GraphBackendOptions options_;
   KeyframeBuildOptions build_;
+  /// Traces and information matrices of the accepted odometry edges (for the fallback).
+  std::vector<std::pair<double, Matrix7d>> accepted_odometry_;
   Sim3Tracker aligner_;
   PoseGraphOptimizer optimizer_;
 };

@@ -30,6 +30,10 @@ struct PoseGraphEdge {
   Sim3d S_i_j;
   Matrix7d information = Matrix7d::Identity();
   EdgeKind kind = EdgeKind::kOdometry;
+  /// The optimiser's robust kernel applies to this edge. A verified loop is not robustified:
+  /// right after closing, its residual is many sigmas (the drift it corrects), and a kernel
+  /// would treat it as the outlier and let the next optimisation undo the correction.
+  bool robust = true;
 };
 
 /// The residual of one edge and its Jacobians with respect to right perturbations of the

@@ -87,7 +87,8 @@ class Solver {
     for (const Problem::Edge& e : p_.edges) {
       const Vector7d r = EdgeError(e.edge->S_i_j, poses[static_cast<std::size_t>(e.vi)],
                                    poses[static_cast<std::size_t>(e.vj)]);
-      cost += 0.5 * optimizer_.KernelCost(r.dot(e.edge->information * r));
+      const double squared = r.dot(e.edge->information * r);
+      cost += 0.5 * (e.edge->robust ? optimizer_.KernelCost(squared) : squared);
     }
     return cost;
   }
@@ -104,7 +105,8 @@ class Solver {
                                             poses[static_cast<std::size_t>(e.vj)]);
       const MatB omega = e.edge->information.template topLeftCorner<B, B>();
       const Eigen::Matrix<double, B, 1> r = res.r.template head<B>();
-      const double w = optimizer_.KernelWeight(res.r.dot(e.edge->information * res.r));
+      const double w =
+          e.edge->robust ? optimizer_.KernelWeight(res.r.dot(e.edge->information * res.r)) : 1.0;
       const MatB Ji = res.J_i.template topLeftCorner<B, B>();
       const MatB Jj = res.J_j.template topLeftCorner<B, B>();
       const MatB JiT_W = w * Ji.transpose() * omega;

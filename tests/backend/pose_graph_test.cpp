@@ -141,6 +141,32 @@ TEST(PoseGraphOptimizer, LoopEdgesRemoveScaleDriftFromAChain) {
   EXPECT_NEAR(graph.Pose(39).Scale() / truth[39].Scale(), 1.0, 0.03);
 }
 
+TEST(PoseGraphOptimizer, EdgesMarkedNotRobustAreExemptFromTheKernel) {
+  // Two vertices, a loop edge 10 sigmas off: under Huber (width 2) its cost is linear beyond
+  // the width; marked not robust (as verified loops are) it is the plain quadratic.
+  const auto cost = [](bool robust) {
+    PoseGraph graph;
+    graph.SetVertex(0, Sim3d(), true);
+    graph.SetVertex(1, Sim3d(1.0, SO3d(), Eigen::Vector3d(1.0, 0.0, 0.0)));
+    PoseGraphEdge e;
+    e.i = 0;
+    e.j = 1;
+    e.S_i_j = Sim3d(1.0, SO3d(), Eigen::Vector3d(1.1, 0.0, 0.0));
+    e.information = 1e4 * Matrix7d::Identity();  // sigma 0.01: the residual is 10 sigmas
+    e.kind = EdgeKind::kLoop;
+    e.robust = robust;
+    graph.AddEdge(e);
+    PoseGraphOptimizerOptions huber;
+    huber.kernel = RobustKernel::kHuber;
+    huber.kernel_width = 2.0;
+    huber.max_iterations = 1;
+    const PoseGraphSummary s = PoseGraphOptimizer(huber).Optimize(&graph);
+    return s.initial_cost;
+  };
+  EXPECT_NEAR(cost(false), 0.5 * 100.0, 1e-6);
+  EXPECT_NEAR(cost(true), 0.5 * (2.0 * 2.0 * 10.0 - 4.0), 1e-6);  // Huber: 2 w e - w^2
+}
+
 TEST(PoseGraphOptimizer, RobustKernelDownWeightsOneWrongEdgeAmongTwenty) {
   std::mt19937_64 rng(5);
   const std::vector<Sim3d> truth = CircleKeyframes(10, rng);
