@@ -64,7 +64,7 @@ class OrbitFeeder {
 
  private:
   FrameResult Feed(const ImageU8& image, const SE3d& truth, bool after_gap) {
-    const FrameResult r = system_.ProcessFrame(image, static_cast<double>(fed_.size()) / 30.0);
+    FrameResult r = system_.ProcessFrame(image, static_cast<double>(fed_.size()) / 30.0);
     fed_.push_back({static_cast<std::int64_t>(fed_.size()), truth, after_gap});
     return r;
   }
