@@ -204,8 +204,8 @@ LoopReport LoopCloser::KeyframeFinished(KeyframeGraph* graph, GraphBackend* back
       graph->MergeMaps(map, candidate_map, S_A_B);
       report.merged_map = map;
     }
-    graph->AddEdge(PoseGraphEdge{candidate.keyframe_id, id, loop->S_a_b, loop->information,
-                                 EdgeKind::kLoop, /*robust=*/false});
+    graph->AddEdge(
+        PoseGraphEdge{candidate.keyframe_id, id, loop->S_a_b, loop->information, EdgeKind::kLoop});
     report.loop_keyframe = candidate.keyframe_id;
     report.optimisation = optimizer_.Optimize(&graph->Poses());
     groups_.clear();  // the loop's neighbourhood is connected now

@@ -30,9 +30,8 @@ struct PoseGraphEdge {
   Sim3d S_i_j;
   Matrix7d information = Matrix7d::Identity();
   EdgeKind kind = EdgeKind::kOdometry;
-  /// The optimiser's robust kernel applies to this edge. A verified loop is not robustified:
-  /// right after closing, its residual is many sigmas (the drift it corrects), and a kernel
-  /// would treat it as the outlier and let the next optimisation undo the correction.
+  /// The optimiser's robust kernel applies to this edge (false: always quadratic). Loop
+  /// edges stay robust: exempting them made the orbits' ATE worse (docs/place_recognition.md).
   bool robust = true;
 };
 
