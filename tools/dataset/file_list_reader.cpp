@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "tools/dataset/input_error.hpp"
+#include "tools/dataset/opencv_image.hpp"
 
 namespace parallax {
 
@@ -72,14 +73,7 @@ ImageU8 ReadGreyImage(const std::string& path, int expected_width, int expected_
   return image;
 }
 
-ImageU8 ReadGreyImage(const std::string& path) {
-  const cv::Mat grey = DecodeGrey(path);
-  ImageU8 image(grey.cols, grey.rows);
-  for (int y = 0; y < grey.rows; ++y) {
-    std::copy(grey.ptr<std::uint8_t>(y), grey.ptr<std::uint8_t>(y) + grey.cols, image.Row(y));
-  }
-  return image;
-}
+ImageU8 ReadGreyImage(const std::string& path) { return ImageFromGreyMat(DecodeGrey(path)); }
 
 std::pair<int, int> ProbeImageSize(const std::string& path) {
   const cv::Mat image = DecodeGrey(path);

@@ -7,6 +7,7 @@
 #include "tools/dataset/calibration_yaml.hpp"
 #include "tools/dataset/file_list_reader.hpp"
 #include "tools/dataset/input_error.hpp"
+#include "tools/dataset/opencv_image.hpp"
 
 namespace fs = std::filesystem;
 
@@ -51,11 +52,7 @@ class VideoReader final : public DatasetReader {
     if (!(t > last_timestamp_)) t = last_timestamp_ + 1.0 / fps_;
     last_timestamp_ = t;
     frame.timestamp = t;
-    frame.image = ImageU8(grey.cols, grey.rows);
-    for (int y = 0; y < grey.rows; ++y) {
-      std::copy(grey.ptr<std::uint8_t>(y), grey.ptr<std::uint8_t>(y) + grey.cols,
-                frame.image.Row(y));
-    }
+    frame.image = ImageFromGreyMat(grey);
     return frame;
   }
 

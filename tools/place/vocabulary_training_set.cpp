@@ -6,6 +6,7 @@
 
 #include "core/check.hpp"
 #include "tools/dataset/file_list_reader.hpp"
+#include "tools/dataset/opencv_image.hpp"
 
 namespace parallax {
 
@@ -24,19 +25,6 @@ void TrainingSetOptions::Check() const {
 
 namespace {
 
-cv::Mat ToMat(const ImageU8& image) {
-  return cv::Mat(image.Height(), image.Width(), CV_8UC1, const_cast<std::uint8_t*>(image.Data()))
-      .clone();
-}
-
-ImageU8 FromMat(const cv::Mat& mat) {
-  ImageU8 image(mat.cols, mat.rows);
-  for (int y = 0; y < mat.rows; ++y) {
-    std::copy(mat.ptr<std::uint8_t>(y), mat.ptr<std::uint8_t>(y) + mat.cols, image.Row(y));
-  }
-  return image;
-}
-
 /// The photograph scaled (area interpolation) to fit width x height times `zoom`.
 cv::Mat Fitted(const cv::Mat& photo, int width, int height, double zoom) {
   const double s = zoom * std::min(static_cast<double>(width) / photo.cols,
@@ -54,16 +42,17 @@ void AddCrops(const cv::Mat& zoomed, int width, int height, std::vector<ImageU8>
   const int h = std::min(height, zoomed.rows);
   const int xs[] = {(zoomed.cols - w) / 2, 0, zoomed.cols - w, 0, zoomed.cols - w};
   const int ys[] = {(zoomed.rows - h) / 2, 0, 0, zoomed.rows - h, zoomed.rows - h};
-  for (int k = 0; k < 5; ++k) views->push_back(FromMat(zoomed(cv::Rect(xs[k], ys[k], w, h))));
+  for (int k = 0; k < 5; ++k)
+    views->push_back(ImageFromGreyMat(zoomed(cv::Rect(xs[k], ys[k], w, h))));
 }
 
 }  // namespace
 
 std::vector<ImageU8> AugmentedViews(const ImageU8& photo, const TrainingSetOptions& options) {
   options.Check();
-  const cv::Mat source = ToMat(photo);
+  const cv::Mat source = GreyMatView(photo);
   const cv::Mat base = Fitted(source, options.width, options.height, 1.0);
-  std::vector<ImageU8> views{FromMat(base)};
+  std::vector<ImageU8> views{ImageFromGreyMat(base)};
   for (const double zoom : options.zooms) {
     AddCrops(Fitted(source, options.width, options.height, zoom), options.width, options.height,
              &views);
@@ -74,7 +63,7 @@ std::vector<ImageU8> AugmentedViews(const ImageU8& photo, const TrainingSetOptio
     cv::Mat rotated;
     cv::warpAffine(base, rotated, cv::getRotationMatrix2D(centre, angle, 1.0), base.size(),
                    cv::INTER_LINEAR, cv::BORDER_REFLECT);
-    views.push_back(FromMat(rotated));
+    views.push_back(ImageFromGreyMat(rotated));
   }
   for (const double gamma : options.gammas) {
     cv::Mat lut(1, 256, CV_8UC1);
@@ -83,12 +72,12 @@ std::vector<ImageU8> AugmentedViews(const ImageU8& photo, const TrainingSetOptio
     }
     cv::Mat adjusted;
     cv::LUT(base, lut, adjusted);
-    views.push_back(FromMat(adjusted));
+    views.push_back(ImageFromGreyMat(adjusted));
   }
   if (options.blur_sigma > 0.0) {
     cv::Mat blurred;
     cv::GaussianBlur(base, blurred, cv::Size(0, 0), options.blur_sigma);
-    views.push_back(FromMat(blurred));
+    views.push_back(ImageFromGreyMat(blurred));
   }
   return views;
 }

@@ -12,6 +12,7 @@
 #include "core/check.hpp"
 #include "tools/dataset/calibration_yaml.hpp"
 #include "tools/dataset/input_error.hpp"
+#include "tools/dataset/opencv_image.hpp"
 #include "tools/dataset/trajectory.hpp"
 #include "tools/synth/random.hpp"
 #include "tools/synth/renderer.hpp"
@@ -125,8 +126,7 @@ SynthSummary WriteSyntheticSequence(const SynthOptions& o, const std::string& ou
     const double t = FrameTimestamp(o, i);
     const std::string stamp = fmt::format("{:.6f}", t);
     const SynthFrame frame = RenderSynthFrame(o, scene, i);
-    WritePng((fs::path(out_dir) / "rgb" / (stamp + ".png")).string(),
-             cv::Mat(o.height, o.width, CV_8UC1, const_cast<std::uint8_t*>(frame.image.Data())));
+    WritePng((fs::path(out_dir) / "rgb" / (stamp + ".png")).string(), GreyMatView(frame.image));
     cv::Mat depth(o.height, o.width, CV_16UC1);
     for (int y = 0; y < o.height; ++y) {
       for (int x = 0; x < o.width; ++x) {
