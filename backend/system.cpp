@@ -110,12 +110,16 @@ void System::FinishCurrentKeyframe(FrameResult* result) {
   backend_stats_.alignments += report.alignments;
   backend_stats_.edges_rejected += report.edges_rejected;
   if (report.optimisation) {
-    ++backend_stats_.optimisations;
-    backend_stats_.iterations += report.optimisation->iterations;
+    CountOptimisation(*report.optimisation);
     backend_stats_.optimisation_ms.push_back(MillisecondsSince(start));
     result->events.push_back({SystemEvent::Kind::kGraphOptimised, result_frame_id_, keyframe->id});
   }
   RecognisePlace(keyframe->id, result);
+}
+
+void System::CountOptimisation(const PoseGraphSummary& summary) {
+  ++backend_stats_.optimisations;
+  backend_stats_.iterations += summary.iterations;
 }
 
 void System::RecognisePlace(std::int64_t id, FrameResult* result) {
@@ -127,10 +131,7 @@ void System::RecognisePlace(std::int64_t id, FrameResult* result) {
   backend_stats_.loop_candidates += loop.candidates;
   backend_stats_.loop_checks += loop.consistent;
   backend_stats_.loops_rejected += loop.rejected;
-  if (loop.optimisation) {
-    ++backend_stats_.optimisations;
-    backend_stats_.iterations += loop.optimisation->iterations;
-  }
+  if (loop.optimisation) CountOptimisation(*loop.optimisation);
   backend_stats_.loop_ms.push_back(MillisecondsSince(start));
   if (loop.merged_map) {
     ++backend_stats_.merges;
@@ -244,9 +245,7 @@ FrameResult System::Process(const std::shared_ptr<const Frame>& frame, const Ima
       result.status = tracked.status;
       result.stats = tracked.stats;
       result.stats.reason = "relocalised";
-      ReturnToKeyframe(Materialize(graph_.GetPtr(relocalised->first), camera_, options_.pyramid,
-                                   options_.reference),
-                       &result);
+      ReturnToKeyframe(relocalised->first, &result);
       tracker_.SetState(MotionState{tracked.T_kf_frame, SE3d(), tracked.affine, 1});
       SetPose(&result, tracked.T_kf_frame);
       result.events.push_back({SystemEvent::Kind::kRelocalised, frame->Id(), current_.id});
@@ -342,8 +341,8 @@ std::optional<TrackingResult> System::TrackRecentKeyframes(const Frame& frame,
   return std::move(found->second);
 }
 
-std::optional<std::pair<std::int64_t, TrackingResult>> System::Relocalise(const Frame& frame,
-                                                                          const ImageU8& image) {
+std::optional<std::pair<std::shared_ptr<const Keyframe>, TrackingResult>> System::Relocalise(
+    const Frame& frame, const ImageU8& image) {
   if (!options_.relocalization.enabled || place_.Size() == 0) return std::nullopt;
   ++backend_stats_.relocalisation_attempts;
   const auto entry = place_.Describe(image);
@@ -354,7 +353,7 @@ std::optional<std::pair<std::int64_t, TrackingResult>> System::Relocalise(const 
         tracker_.TrackFrom(*keyframe->reference, frame, guess.T_kf_frame, AffineBrightness{});
     if (r.status != TrackingStatus::kOk) continue;
     ++backend_stats_.relocalisations;
-    return std::make_pair(guess.keyframe_id, std::move(r));
+    return std::make_pair(keyframe, std::move(r));
   }
   return std::nullopt;
 }

@@ -237,14 +237,16 @@ class System {
                      InverseDepthMap map, FrameResult* result);
   /// Freezes the current keyframe into the graph and runs the backend on it.
   void FinishCurrentKeyframe(FrameResult* result);
+  /// Adds an optimisation to the backend statistics.
+  void CountOptimisation(const PoseGraphSummary& summary);
   /// Place recognition for the finished keyframe `id` (its entry in the database); a
   /// verified loop becomes an edge.
   void RecognisePlace(std::int64_t id, FrameResult* result);
   /// For a frame lost against the current and recent keyframes: database candidates, PnP on
   /// their depth, direct confirmation; the keyframe found becomes current.
-  /// Returns the keyframe found and the frame tracked on it.
-  std::optional<std::pair<std::int64_t, TrackingResult>> Relocalise(const Frame& frame,
-                                                                    const ImageU8& image);
+  /// Returns the keyframe found (rebuilt if it was compacted) and the frame tracked on it.
+  std::optional<std::pair<std::shared_ptr<const Keyframe>, TrackingResult>> Relocalise(
+      const Frame& frame, const ImageU8& image);
   /// Makes keyframe `keyframe` (in the graph) current again: the current one is finished;
   /// its mutable map comes from the recent ones or is rebuilt from its frozen depth.
   void ReturnToKeyframe(const std::shared_ptr<const Keyframe>& keyframe, FrameResult* result);
