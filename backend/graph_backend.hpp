@@ -72,6 +72,9 @@ class GraphBackend {
                                  std::optional<std::int64_t> parent, const Sim3d& S_parent_kf);
 
   const GraphBackendOptions& Options() const { return options_; }
+  /// The information of an odometry edge whose alignment failed (see the options); also
+  /// the weight of the unfinished keyframe's edge in a saved map.
+  Matrix7d FallbackInformation() const;
 
   /// A direct Sim(3) alignment of two keyframes, checked both ways.
   struct Alignment {
@@ -92,9 +95,6 @@ class GraphBackend {
  private:
   std::vector<std::int64_t> NeighbourCandidates(const KeyframeGraph& graph, std::int64_t id,
                                                 std::optional<std::int64_t> parent) const;
-
-  /// The information of an odometry edge whose alignment failed (see the options).
-  Matrix7d FallbackInformation() const;
 
   GraphBackendOptions options_;
   KeyframeBuildOptions build_;

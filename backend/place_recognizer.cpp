@@ -71,8 +71,12 @@ PlaceRecognizer::PlaceRecognizer(const Vocabulary& vocabulary,
 }
 
 std::shared_ptr<const PlaceEntry> PlaceRecognizer::Describe(const ImageU8& image) const {
+  return Describe(ExtractOrb(image, options_.orb));
+}
+
+std::shared_ptr<const PlaceEntry> PlaceRecognizer::Describe(OrbFeatures features) const {
   auto entry = std::make_shared<PlaceEntry>();
-  entry->features = ExtractOrb(image, options_.orb);
+  entry->features = std::move(features);
   entry->bow = vocabulary_->Transform(entry->features.descriptors, &entry->direct,
                                       options_.direct_index_level);
   return entry;

@@ -48,12 +48,17 @@ class PlaceRecognizer {
 
   /// Features and vectors of an image (not stored).
   std::shared_ptr<const PlaceEntry> Describe(const ImageU8& image) const;
+  /// Vectors of features extracted earlier (e.g. read from a map file), not stored.
+  std::shared_ptr<const PlaceEntry> Describe(OrbFeatures features) const;
   /// Stores the entry of keyframe `id` and adds it to the database.
   void Add(std::int64_t id, std::shared_ptr<const PlaceEntry> entry);
   void Remove(std::int64_t id);
   bool Contains(std::int64_t id) const { return entries_.count(id) > 0; }
   /// Throws std::out_of_range for an unknown id.
   const PlaceEntry& Entry(std::int64_t id) const { return *entries_.at(id); }
+  const std::shared_ptr<const PlaceEntry>& EntryPtr(std::int64_t id) const {
+    return entries_.at(id);
+  }
   const KeyframeDatabase& Database() const { return database_; }
   const PlaceRecognitionOptions& Options() const { return options_; }
   std::size_t Size() const { return entries_.size(); }

@@ -93,6 +93,7 @@ RevisedPose System::Revised(const Frame& frame, const std::optional<SE3d>& T_kf_
 }
 
 void System::FinishCurrentKeyframe(FrameResult* result) {
+  if (!mapper_.HasMap()) return;  // a loaded map before its first relocalisation
   const std::shared_ptr<Keyframe> keyframe = mapper_.Freeze();
   const bool is_new = !graph_.Contains(keyframe->id);
   graph_.Upsert(keyframe, CurrentKeyframePose(), current_map_);
@@ -168,7 +169,7 @@ void System::StartKeyframe(const std::shared_ptr<const Frame>& frame, const Sim3
 void System::CompactOldKeyframes() { graph_.Compact(mapper_.LiveKeyframeIds()); }
 
 void System::Record(std::int64_t frame_id, const FrameResult& result) {
-  const auto index = static_cast<std::size_t>(frame_id);
+  const std::size_t index = FrameIndex(frame_id);
   frame_poses_.resize(std::max(frame_poses_.size(), index + 1));
   frame_poses_[index] = result.anchor;
   for (const RevisedPose& r : result.revised) {
@@ -176,7 +177,7 @@ void System::Record(std::int64_t frame_id, const FrameResult& result) {
     // again on the converged depth is the better one (TUM clip: 5.9 mm against 14.9 with the
     // live pose), unless the frame became the next keyframe, which is anchored at itself.
     if (r.frame_id == frame_id && result.is_keyframe) continue;
-    auto& pose = frame_poses_[static_cast<std::size_t>(r.frame_id)];
+    auto& pose = frame_poses_[FrameIndex(r.frame_id)];
     pose.reset();
     if (r.T_w_c) pose = AnchoredPose{r.keyframe_id, r.T_kf_frame};
   }
@@ -229,6 +230,7 @@ FrameResult System::ProcessFrame(const ImageU8& image, double timestamp) {
 
 FrameResult System::Process(const std::shared_ptr<const Frame>& frame, const ImageU8& image) {
   if (start_ == StartState::kNoKeyframe) return StartFirstKeyframe(frame, image);
+  if (start_ == StartState::kRelocalising) return ProcessOnLoadedMap(frame, image);
   if (start_ == StartState::kTwoViewSearch) return ProcessTwoViewOnly(frame, image);
   FrameResult result;
   TrackingResult tracked = TrackFrame(*frame, &result);
@@ -379,7 +381,7 @@ void System::ReturnToKeyframe(const std::shared_ptr<const Keyframe>& keyframe,
         map.observations[static_cast<std::size_t>(keyframe->depth.pixel[k])] = 0;
       }
     }
-    mapper_.Retire();
+    if (mapper_.HasMap()) mapper_.Retire();
     mapper_.SetMap(std::move(map));
     mapper_.Direction().Reset();
   }
@@ -454,7 +456,7 @@ std::vector<FramePose> System::Trajectory() const {
     if (!anchor || (anchor->keyframe_id != current_.id && !graph_.Contains(anchor->keyframe_id)))
       continue;
     const Sim3d S_w_kf = KeyframePose(anchor->keyframe_id);
-    poses.push_back({static_cast<std::int64_t>(k), frame_timestamps_[k],
+    poses.push_back({first_frame_id_ + static_cast<std::int64_t>(k), frame_timestamps_[k],
                      (S_w_kf * Sim3d(anchor->T_kf_frame)).RigidPart()});
   }
   return poses;

@@ -7,6 +7,8 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <span>
+#include <string>
 #include <vector>
 
 #include "backend/frame_tracker.hpp"
@@ -219,16 +221,35 @@ class System {
   void ForEachMapPoint(const std::function<void(const Eigen::Vector3f&)>& fn) const;
   /// Every frame that has a pose, in frame order, through its keyframe's current pose.
   std::vector<FramePose> Trajectory() const;
+
+  /// Writes the map (every keyframe, the unfinished current one included, with its depth,
+  /// pose, edges and ORB features) to `path` atomically (docs/map_files.md). Changes nothing
+  /// in the system. Throws std::logic_error before the first keyframe is initialised and
+  /// MapFileError when the file cannot be written.
+  void SaveMap(const std::string& path) const;
+  /// The map file's bytes (as SaveMap writes them).
+  std::vector<std::uint8_t> EncodeMapBytes() const;
+  /// Loads a map into a system that has not processed a frame yet: the next frames are
+  /// relocalised on it and, once one is found, tracked and mapped in its world frame (a new
+  /// map is started after `new_map_after_lost_s` without relocalisation). Frame ids continue
+  /// after the saved ones. Throws std::logic_error when frames were processed and
+  /// MapFileError for an unreadable, corrupt or foreign file (the camera must be the same);
+  /// on a throw the system is unchanged.
+  void LoadMap(const std::string& path);
+  void LoadMapBytes(std::span<const std::uint8_t> bytes, const std::string& source);
+  /// True while a loaded map waits for the first relocalisation.
+  bool AwaitingRelocalisation() const { return start_ == StartState::kRelocalising; }
   const KeyframeGraph& Graph() const { return graph_; }
   /// The map new keyframes currently join (0 until a long loss started another).
   int CurrentMap() const { return current_map_; }
   const BackendStats& Backend() const { return backend_stats_; }
   /// Memory held by place recognition (keyframe features and vectors).
   std::size_t PlaceRecognitionBytes() const { return place_.Bytes(); }
-  int FramesProcessed() const { return frame_count_; }
+  int FramesProcessed() const { return static_cast<int>(frame_count_ - first_frame_id_); }
   /// Frames rejected by the quality gate (SystemOptions::quality).
   int FramesUnusable() const { return frames_unusable_; }
-  /// Index of the frame at which initialisation completed; -1 while initialising.
+  /// Index of the frame at which initialisation completed (or a loaded map was first
+  /// relocalised), counted from this system's first frame; -1 while initialising.
   int InitialisedAtFrame() const { return initialised_at_frame_; }
 
  private:
@@ -253,6 +274,12 @@ class System {
   /// Recovery from long loss: the lost map's current keyframe is finished and a new map
   /// starts at `frame` (its own world frame until a loop merges it).
   FrameResult StartNewMap(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
+  /// kRelocalising: the frame is relocalised on the loaded map or reported lost.
+  FrameResult ProcessOnLoadedMap(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
+  /// Index of a frame id in frame_poses_ / frame_timestamps_.
+  std::size_t FrameIndex(std::int64_t frame_id) const {
+    return static_cast<std::size_t>(frame_id - first_frame_id_);
+  }
   /// Keyframe-to-world pose of the current keyframe (through its parent while unfinished).
   Sim3d CurrentKeyframePose() const;
   Sim3d KeyframePose(std::int64_t id) const;
@@ -315,6 +342,8 @@ class System {
   ///   (random depth); kRandomPairSearch --pair--> kRandomPairHeld, --gave up--> kConverging;
   ///   kRandomPairHeld --lost: start from the pair--> kConverging; any of them --enough depth
   ///   updates or a keyframe--> kInitialised; --too long lost--> kNoKeyframe (restart).
+  ///   A loaded map starts in kRelocalising --relocalised--> kInitialised, --lost for
+  ///   new_map_after_lost_s--> a new map (kNoKeyframe).
   enum class StartState {
     kNoKeyframe,        ///< waiting for a frame with enough texture
     kTwoViewSearch,     ///< two_view: keyframe with an empty map, frames only feed the search
@@ -322,6 +351,7 @@ class System {
     kRandomPairHeld,    ///< auto: a pair is held until the random start converges or fails
     kConverging,        ///< the first keyframe's depth converges; no pair work left
     kInitialised,
+    kRelocalising,  ///< a loaded map: every frame is relocalised on it until one is found
   };
   StartState start_ = StartState::kNoKeyframe;
   FrameTracker tracker_;
@@ -345,7 +375,9 @@ class System {
   std::vector<std::optional<AnchoredPose>> frame_poses_;
   std::vector<double> frame_timestamps_;
   std::int64_t result_frame_id_ = 0;  ///< the frame being processed (for events)
-  int frame_count_ = 0;
+  /// Frame ids: the next one, and this system's first (after the ids of a loaded map).
+  std::int64_t frame_count_ = 0;
+  std::int64_t first_frame_id_ = 0;
   int frames_unusable_ = 0;
   int depth_updates_ = 0;
   int initialised_at_frame_ = -1;
@@ -356,7 +388,8 @@ class System {
   /// The map new keyframes join, and the id the next new map gets.
   int current_map_ = 0;
   int next_map_ = 1;
-  /// Timestamp of the last frame that got a pose (long-loss timer).
+  /// Timestamp of the last frame that got a pose (long-loss timer; on a loaded map, of the
+  /// first frame given to it).
   double last_posed_timestamp_ = 0.0;
   std::unique_ptr<TwoViewBootstrap> bootstrap_;  ///< set while a two-view pair is sought
   int bootstrap_tries_ = 0;

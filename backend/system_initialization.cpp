@@ -111,7 +111,9 @@ std::vector<RevisedPose> System::FinishInitialisation() {
   initial_frames_.clear();
   bootstrap_.reset();
   start_ = StartState::kInitialised;
-  if (initialised_at_frame_ < 0) initialised_at_frame_ = frame_count_ - 1;  // the first map's
+  if (initialised_at_frame_ < 0) {  // the first map's
+    initialised_at_frame_ = static_cast<int>(frame_count_ - 1 - first_frame_id_);
+  }
   return revised;
 }
 

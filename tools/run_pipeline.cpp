@@ -79,9 +79,11 @@ void Summarise(const System& system, const std::vector<double>& tracking_ms,
 
 RunSummary RunDataset(const RunOptions& options) {
   CheckArgument(options.max_frames >= 0, "--max-frames must be >= 0");
+  CheckArgument(options.first_frame >= 0, "--first-frame must be >= 0");
   const auto reader = OpenDataset(options.dataset, options.dataset_options);
   const Undistorter undistorter(reader->GetCamera(), reader->SuggestedRectification());
   System system(undistorter.OutputCamera(), options.system);
+  if (!options.load_map.empty()) system.LoadMap(options.load_map);
   RunOutputs outputs(options.out_dir, options.trajectory_format, options.dataset);
   std::vector<double> tracking_ms, mapping_ms;
   RunSummary summary;
@@ -96,6 +98,7 @@ RunSummary RunDataset(const RunOptions& options) {
       }
       const auto frame = frames.Next();
       if (!frame) break;
+      if (frame->index < static_cast<std::size_t>(options.first_frame)) continue;
       ++summary.frames;
       if (!frame->error.empty()) {
         ++summary.frames_unreadable;
@@ -123,6 +126,7 @@ RunSummary RunDataset(const RunOptions& options) {
   if (summary.frames == 0) throw InputError(options.dataset, "has no frames");
   Summarise(system, tracking_ms, mapping_ms, start, &summary);
   outputs.Finish(system, &summary, summary.status);
+  if (!options.save_map.empty()) system.SaveMap(options.save_map);
   return summary;
 }
 

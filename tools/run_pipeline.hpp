@@ -15,6 +15,13 @@ struct RunOptions {
   DatasetOptions dataset_options;
   std::string out_dir = "parallax_out";
   int max_frames = 0;  ///< 0: all
+  /// Frames of the dataset before this index are read and skipped (not counted, not
+  /// logged): a run over the second part of a sequence, e.g. on a map saved from the first.
+  int first_frame = 0;
+  /// A map file loaded before the first frame (the frames are relocalised on it and continue
+  /// in its world frame), and one written at the end (docs/map_files.md); empty: none.
+  std::string load_map;
+  std::string save_map;
   SystemOptions system;
   bool progress = false;  ///< a progress line on stderr
   /// trajectory*.txt as TUM (timestamp tx ty tz qx qy qz qw) or KITTI (row-major 3x4 per
@@ -72,7 +79,10 @@ struct RunSummary {
 /// out_dir/{trajectory.txt (every posed frame through the final, optimised keyframe graph),
 /// trajectory_online.txt (the poses as reported live), keyframes.txt, map.ply, stats.json,
 /// frames.csv (per frame: status, whether posed, keyframe, tracking and mapping ms, events)}.
-/// Throws InputError for bad input (naming the file) and std::invalid_argument for bad options.
+/// With `save_map` the map is written after the outputs (also for an interrupted run).
+/// Throws InputError for bad input (naming the file), MapFileError for a map file that
+/// cannot be read or written, std::logic_error when there is no map to save, and
+/// std::invalid_argument for bad options.
 RunSummary RunDataset(const RunOptions& options);
 
 }  // namespace parallax

@@ -1,5 +1,6 @@
 // parallax run <dataset> [--format F] [--calib FILE] [--config FILE] [--out DIR]
-//              [--max-frames N] [--no-loop-closure]
+//              [--max-frames N] [--first-frame N] [--no-loop-closure] [--save-map FILE]
+//              [--load-map FILE]
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -44,6 +45,14 @@ void AddRunCommand(CLI::App& app, int* exit_code) {
   cmd->add_option("--trajectory-format", *trajectory_format,
                   "trajectory files as tum, or kitti (+ <name>.times.txt)")
       ->check(CLI::IsMember({"tum", "kitti"}));
+  cmd->add_option("--first-frame", options->first_frame,
+                  "skip the dataset's frames before this index")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--save-map", options->save_map,
+                  "write the map to FILE at the end (docs/map_files.md)");
+  cmd->add_option("--load-map", options->load_map,
+                  "start on the map in FILE: frames are relocalised on it and continue in its "
+                  "world frame");
   auto no_loop_closure = std::make_shared<bool>(false);
   cmd->add_flag("--no-loop-closure", *no_loop_closure,
                 "disable place recognition and loop closure (on by default)");
