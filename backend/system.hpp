@@ -237,6 +237,11 @@ class System {
   /// on a throw the system is unchanged.
   void LoadMap(const std::string& path);
   void LoadMapBytes(std::span<const std::uint8_t> bytes, const std::string& source);
+  /// True while the current map has no initialised keyframe yet (the start, or a new map
+  /// after a long loss); frames may have provisional poses.
+  bool Initialising() const {
+    return start_ != StartState::kInitialised && start_ != StartState::kRelocalising;
+  }
   /// True while a loaded map waits for the first relocalisation.
   bool AwaitingRelocalisation() const { return start_ == StartState::kRelocalising; }
   const KeyframeGraph& Graph() const { return graph_; }
@@ -245,6 +250,8 @@ class System {
   const BackendStats& Backend() const { return backend_stats_; }
   /// Memory held by place recognition (keyframe features and vectors).
   std::size_t PlaceRecognitionBytes() const { return place_.Bytes(); }
+  /// The id the next frame will get (ids continue after a loaded map's).
+  std::int64_t NextFrameId() const { return frame_count_; }
   int FramesProcessed() const { return static_cast<int>(frame_count_ - first_frame_id_); }
   /// Frames rejected by the quality gate (SystemOptions::quality).
   int FramesUnusable() const { return frames_unusable_; }

@@ -129,17 +129,8 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
   };
 }
 
-}  // namespace
-
-void ApplyConfigYaml(const std::string& path, SystemOptions* options) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "cannot open configuration file");
-  YAML::Node root;
-  try {
-    root = YAML::Load(in);
-  } catch (const YAML::ParserException& e) {
-    throw InputError(path, e.mark.line + 1, "YAML syntax error: " + e.msg);
-  }
+/// `root` parsed from `path` (a file name, or the name given to a YAML string).
+void ApplyConfigRoot(const YAML::Node& root, const std::string& path, SystemOptions* options) {
   if (root.IsNull()) return;  // empty file: defaults
   if (!root.IsMap()) throw InputError(path, "configuration must be a YAML mapping of sections");
   SystemOptions updated = *options;
@@ -178,6 +169,30 @@ void ApplyConfigYaml(const std::string& path, SystemOptions* options) {
     throw InputError(path, e.what());
   }
   *options = updated;
+}
+
+}  // namespace
+
+void ApplyConfigYaml(const std::string& path, SystemOptions* options) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "cannot open configuration file");
+  YAML::Node root;
+  try {
+    root = YAML::Load(in);
+  } catch (const YAML::ParserException& e) {
+    throw InputError(path, e.mark.line + 1, "YAML syntax error: " + e.msg);
+  }
+  ApplyConfigRoot(root, path, options);
+}
+
+void ApplyConfigYamlText(const std::string& text, const std::string& name, SystemOptions* options) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw InputError(name, e.mark.line + 1, "YAML syntax error: " + e.msg);
+  }
+  ApplyConfigRoot(root, name, options);
 }
 
 }  // namespace parallax
