@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cmath>
 
+#include "backend/live_tracker.hpp"
+#include "backend/mapping_worker.hpp"
 #include "core/check.hpp"
 
 namespace parallax {
@@ -27,6 +29,7 @@ void SystemOptions::Check() const {
   backend.Check();
   loop_closure.Check();
   relocalization.Check();
+  realtime.Check();
   CheckOption(new_map_after_lost_s > 0.0, "SystemOptions", "new_map_after_lost_s", "must be > 0");
   CheckOption(bootstrap_max_frames >= 1, "SystemOptions", "bootstrap_max_frames", "must be >= 1");
   CheckOption(auto_max_rotation_deg > 0.0, "SystemOptions", "auto_max_rotation_deg", "must be > 0");
@@ -62,6 +65,7 @@ System::System(const PinholeCamera& camera, const SystemOptions& options)
       loop_closer_(options.loop_closure, &place_, camera),
       relocalizer_(options.relocalization, camera) {
   options_.Check();
+  if (options_.realtime.enabled) StartRealtime();
 }
 
 Sim3d System::KeyframePose(std::int64_t id) const {
@@ -105,17 +109,29 @@ void System::FinishCurrentKeyframe(FrameResult* result) {
     }
     return;
   }
+  FinishedKeyframe finished{keyframe->id, is_new ? current_.parent : std::nullopt,
+                            current_.S_parent_kf};
+  // Real-time mode: the caller may be waiting for the next keyframe; the backend's work on
+  // this one runs after it is released (RunDeferredBackend).
+  if (live_) {
+    deferred_backend_.push_back(finished);
+    return;
+  }
+  RunBackend(finished, result);
+}
+
+void System::RunBackend(const FinishedKeyframe& finished, FrameResult* result) {
   const auto start = Clock::now();
-  const BackendReport report = backend_.KeyframeFinished(
-      &graph_, keyframe->id, is_new ? current_.parent : std::nullopt, current_.S_parent_kf);
+  const BackendReport report =
+      backend_.KeyframeFinished(&graph_, finished.id, finished.parent, finished.S_parent_kf);
   backend_stats_.alignments += report.alignments;
   backend_stats_.edges_rejected += report.edges_rejected;
   if (report.optimisation) {
     CountOptimisation(*report.optimisation);
     backend_stats_.optimisation_ms.push_back(MillisecondsSince(start));
-    result->events.push_back({SystemEvent::Kind::kGraphOptimised, result_frame_id_, keyframe->id});
+    result->events.push_back({SystemEvent::Kind::kGraphOptimised, result_frame_id_, finished.id});
   }
-  RecognisePlace(keyframe->id, result);
+  RecognisePlace(finished.id, result);
 }
 
 void System::CountOptimisation(const PoseGraphSummary& summary) {
@@ -169,6 +185,7 @@ void System::StartKeyframe(const std::shared_ptr<const Frame>& frame, const Sim3
 void System::CompactOldKeyframes() { graph_.Compact(mapper_.LiveKeyframeIds()); }
 
 void System::Record(std::int64_t frame_id, const FrameResult& result) {
+  const std::lock_guard<std::mutex> lock(poses_mutex_);
   const std::size_t index = FrameIndex(frame_id);
   frame_poses_.resize(std::max(frame_poses_.size(), index + 1));
   frame_poses_[index] = result.anchor;
@@ -202,28 +219,37 @@ FrameResult System::ProcessFrame(const ImageU8& image, double timestamp) {
                     std::to_string(image.Height()) + ", the camera " +
                     std::to_string(camera_.Width()) + "x" + std::to_string(camera_.Height()));
   const FrameQuality quality = AssessFrame(image, options_.quality);
+  const std::int64_t id = frame_count_++;
+  {
+    const std::lock_guard<std::mutex> lock(poses_mutex_);
+    frame_timestamps_.push_back(timestamp);
+  }
   if (!quality.Usable()) {
     // No tracking and no depth update from it: nothing of the map or the motion changes.
-    const std::int64_t id = frame_count_++;
-    frame_timestamps_.push_back(timestamp);
     ++frames_unusable_;
     FrameResult result;
     result.stats.reason = quality.Reason();
     result.events.push_back({SystemEvent::Kind::kLost, id, -1});
     Record(id, result);
+    TakePendingEvents(&result);
     return result;
   }
-  auto frame =
-      std::make_shared<const Frame>(frame_count_, timestamp, camera_, image, options_.pyramid);
-  ++frame_count_;
-  frame_timestamps_.push_back(timestamp);
+  if (live_) return ProcessLive(id, timestamp, image);
+  auto frame = std::make_shared<const Frame>(id, timestamp, camera_, image, options_.pyramid);
+  const std::lock_guard<std::mutex> lock(engine_mutex_);
+  return ProcessInOrder(frame, image);
+}
+
+FrameResult System::ProcessInOrder(const std::shared_ptr<const Frame>& frame,
+                                   const ImageU8& image) {
   result_frame_id_ = frame->Id();
   FrameResult result = Process(frame, image);
   if (!result.T_w_c) result.events.push_back({SystemEvent::Kind::kLost, frame->Id(), -1});
   if (!result.revised.empty()) {
     result.events.push_back({SystemEvent::Kind::kPosesRevised, frame->Id(), -1});
   }
-  if (result.T_w_c) last_posed_timestamp_ = timestamp;
+  if (result.T_w_c) last_posed_timestamp_ = frame->Timestamp();
+  result.initialising = start_ != StartState::kInitialised && start_ != StartState::kRelocalising;
   Record(frame->Id(), result);
   return result;
 }
@@ -419,6 +445,11 @@ std::vector<Eigen::Vector3f> System::MapPoints() const {
 }
 
 void System::ForEachMapPoint(const std::function<void(const Eigen::Vector3f&)>& fn) const {
+  const std::lock_guard<std::mutex> lock(engine_mutex_);
+  ForEachMapPointLocked(fn);
+}
+
+void System::ForEachMapPointLocked(const std::function<void(const Eigen::Vector3f&)>& fn) const {
   graph_.ForEachMapPoint(camera_, fn);
   if (mapper_.HasMap() && !graph_.Contains(current_.id)) {
     // The current keyframe's confirmed points, through its current pose.
@@ -437,18 +468,21 @@ void System::ForEachMapPoint(const std::function<void(const Eigen::Vector3f&)>& 
 }
 
 std::vector<KeyframeRecord> System::Keyframes() const {
+  const std::lock_guard<std::mutex> engine(engine_mutex_);
   std::vector<KeyframeRecord> records;
   for (const std::int64_t id : graph_.Ids()) {
-    records.push_back({id, graph_.Get(id).timestamp, graph_.Pose(id)});
+    records.push_back({id, graph_.Get(id).timestamp, graph_.Pose(id), graph_.MapOf(id)});
   }
   if (mapper_.HasMap() && !graph_.Contains(current_.id)) {
-    records.push_back(
-        {current_.id, mapper_.Map().KeyframePtr()->Timestamp(), CurrentKeyframePose()});
+    records.push_back({current_.id, mapper_.Map().KeyframePtr()->Timestamp(), CurrentKeyframePose(),
+                       current_map_});
   }
   return records;
 }
 
 std::vector<FramePose> System::Trajectory() const {
+  const std::lock_guard<std::mutex> engine(engine_mutex_);
+  const std::lock_guard<std::mutex> frames(poses_mutex_);
   std::vector<FramePose> poses;
   for (std::size_t k = 0; k < frame_poses_.size(); ++k) {
     const auto& anchor = frame_poses_[k];
@@ -460,6 +494,36 @@ std::vector<FramePose> System::Trajectory() const {
                      (S_w_kf * Sim3d(anchor->T_kf_frame)).RigidPart()});
   }
   return poses;
+}
+
+BackendStats System::Backend() const {
+  const std::lock_guard<std::mutex> lock(engine_mutex_);
+  return backend_stats_;
+}
+
+int System::CurrentMap() const {
+  const std::lock_guard<std::mutex> lock(engine_mutex_);
+  return current_map_;
+}
+
+std::size_t System::PlaceRecognitionBytes() const {
+  const std::lock_guard<std::mutex> lock(engine_mutex_);
+  return place_.Bytes();
+}
+
+int System::InitialisedAtFrame() const {
+  const std::lock_guard<std::mutex> lock(engine_mutex_);
+  return initialised_at_frame_;
+}
+
+bool System::Initialising() const {
+  const std::lock_guard<std::mutex> lock(engine_mutex_);
+  return start_ != StartState::kInitialised && start_ != StartState::kRelocalising;
+}
+
+bool System::AwaitingRelocalisation() const {
+  const std::lock_guard<std::mutex> lock(engine_mutex_);
+  return start_ == StartState::kRelocalising;
 }
 
 }  // namespace parallax

@@ -6,6 +6,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
@@ -38,6 +39,30 @@ enum class Initialization {
   kAuto,
   kRandom,   ///< LSD-SLAM style random inverse depth refined by the first frames
   kTwoView,  ///< ORB + essential matrix between the first frame and a later one, then stereo
+};
+
+/// The real-time mode (docs/realtime.md): tracking on the caller's thread against the
+/// published keyframe, depth updates, keyframes and the backend on a mapping thread.
+struct RealtimeOptions {
+  bool enabled = false;
+  /// Tracked frames that may wait for the mapping thread; when more arrive, the oldest
+  /// waiting one is skipped (the newest refines depth best).
+  int max_pending_frames = 1;
+  /// TBB concurrency of tracking (caller's thread) and of the mapping thread: the two-core
+  /// budget is one each, so that neither oversubscribes the other.
+  int tracking_threads = 1;
+  int mapping_threads = 1;
+  /// OpenCV's thread pool (ORB extraction on the mapping thread) is process-wide: a
+  /// real-time System sets it to this when it starts.
+  int opencv_threads = 1;
+  /// A frame past the keyframe rule asks mapping for a new keyframe and tracking goes on
+  /// against the current one; when the rule's distance is exceeded by this factor (or
+  /// usage and consistency fall below the rule's thresholds divided by it) before the new
+  /// keyframe exists, tracking waits for it (unthrottled input would otherwise outrun the
+  /// map: measured 12.9% of path on a 300-frame orbit without the wait).
+  double keyframe_wait_factor = 1.5;
+
+  void Check() const;
 };
 
 struct SystemOptions {
@@ -110,6 +135,7 @@ struct SystemOptions {
   /// seconds) and relocalisation keeps failing, a new map is started at the next frame that
   /// can start one; a later loop to an earlier map merges the two.
   double new_map_after_lost_s = 2.0;
+  RealtimeOptions realtime;
 
   void Check() const;
 };
@@ -160,6 +186,14 @@ struct FramePose {
   SE3d T_w_c;
 };
 
+/// Real-time mode figures (zero in the deterministic mode).
+struct RealtimeStats {
+  std::int64_t frames_tracked_live = 0;  ///< answered by the caller's tracker alone
+  std::int64_t frames_mapped_waiting =
+      0;  ///< the caller waited for mapping (start, lost, keyframe)
+  std::int64_t frames_skipped_by_mapping = 0;  ///< tracked, never used to refine depth
+};
+
 /// Keyframe-graph figures for stats.json.
 struct BackendStats {
   int optimisations = 0;
@@ -186,6 +220,9 @@ struct FrameResult {
   std::optional<SE3d> T_w_c;
   std::optional<AnchoredPose> anchor;
   bool is_keyframe = false;
+  /// The map had no initialised keyframe yet when the frame was posed (its pose is
+  /// provisional: the start may revise or withdraw it).
+  bool initialising = false;
   TrackingStats stats;
   double tracking_ms = 0.0;  ///< wall time of tracking this frame
   double mapping_ms = 0.0;   ///< depth update and keyframe creation
@@ -198,19 +235,42 @@ struct FrameResult {
 struct KeyframeRecord {
   std::int64_t frame_id = 0;
   double timestamp = 0.0;
-  Sim3d S_w_kf;  ///< keyframe-to-world similarity (scale: the keyframe's normalised depth)
+  Sim3d S_w_kf;    ///< keyframe-to-world similarity (scale: the keyframe's normalised depth)
+  int map_id = 0;  ///< the map (world frame) it belongs to
 };
 
-/// Runs tracking and mapping for each frame in order (deterministic). Owns no threads yet;
-/// the real-time mode will split tracking and mapping behind the same interface.
+struct MappingJob;
+struct LiveTracking;
+class MappingWorker;
+struct LiveTracker;
+
+/// Runs tracking and mapping for each frame. Deterministic mode: every stage in order on the
+/// caller's thread (bit-identical results). Real-time mode (options.realtime): tracking on
+/// the caller's thread, mapping and the backend on a thread the System owns
+/// (docs/realtime.md). A System is used from one thread at a time; its queries are safe
+/// while its mapping thread runs, except Graph(), which needs FinishMapping() first.
 class System {
  public:
   /// `camera` is the ideal pinhole camera of the (already undistorted) images.
   explicit System(const PinholeCamera& camera, const SystemOptions& options = {});
+  /// Stops the mapping thread (waiting frames are dropped, the running one finishes).
+  ~System();
+  System(const System&) = delete;
+  System& operator=(const System&) = delete;
 
   /// Processes one undistorted 8-bit image. Throws std::invalid_argument for a wrong size,
-  /// before anything changes.
+  /// before anything changes. Real-time mode: returns once the frame is tracked (waiting for
+  /// mapping only at the start, when lost, or when a new keyframe must exist first); events
+  /// of the mapping thread come with the next result; an exception the mapping thread threw
+  /// is rethrown here.
   FrameResult ProcessFrame(const ImageU8& image, double timestamp);
+  /// Real-time mode: returns when every frame handed to mapping is mapped (then Graph() and
+  /// the outputs are final). No-op in the deterministic mode.
+  void FinishMapping();
+  /// Real-time mode: drops the frames waiting for mapping, lets the running one finish and
+  /// stops the thread (keyframes already made are kept; later frames are refused).
+  void StopMapping();
+  RealtimeStats Realtime() const;
 
   /// Every keyframe (finished ones through the optimised graph, then the current one).
   std::vector<KeyframeRecord> Keyframes() const;
@@ -239,17 +299,15 @@ class System {
   void LoadMapBytes(std::span<const std::uint8_t> bytes, const std::string& source);
   /// True while the current map has no initialised keyframe yet (the start, or a new map
   /// after a long loss); frames may have provisional poses.
-  bool Initialising() const {
-    return start_ != StartState::kInitialised && start_ != StartState::kRelocalising;
-  }
+  bool Initialising() const;
   /// True while a loaded map waits for the first relocalisation.
-  bool AwaitingRelocalisation() const { return start_ == StartState::kRelocalising; }
+  bool AwaitingRelocalisation() const;
   const KeyframeGraph& Graph() const { return graph_; }
   /// The map new keyframes currently join (0 until a long loss started another).
-  int CurrentMap() const { return current_map_; }
-  const BackendStats& Backend() const { return backend_stats_; }
+  int CurrentMap() const;
+  BackendStats Backend() const;
   /// Memory held by place recognition (keyframe features and vectors).
-  std::size_t PlaceRecognitionBytes() const { return place_.Bytes(); }
+  std::size_t PlaceRecognitionBytes() const;
   /// The id the next frame will get (ids continue after a loaded map's).
   std::int64_t NextFrameId() const { return frame_count_; }
   int FramesProcessed() const { return static_cast<int>(frame_count_ - first_frame_id_); }
@@ -257,14 +315,41 @@ class System {
   int FramesUnusable() const { return frames_unusable_; }
   /// Index of the frame at which initialisation completed (or a loaded map was first
   /// relocalised), counted from this system's first frame; -1 while initialising.
-  int InitialisedAtFrame() const { return initialised_at_frame_; }
+  int InitialisedAtFrame() const;
 
  private:
   FrameResult Process(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
+  /// The deterministic pipeline on one frame, with its events and record (engine lock held).
+  FrameResult ProcessInOrder(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
+  // Real-time mode (system_realtime.cpp).
+  /// Tracks on the caller's thread against the published keyframe; hands the frame on.
+  FrameResult ProcessLive(std::int64_t id, double timestamp, const ImageU8& image);
+  /// The mapping thread's work on one frame (takes the engine lock).
+  FrameResult MapJob(const MappingJob& job);
+  /// After a mapped frame: what the live tracker reads (engine lock held).
+  void PublishLive();
+  void StartRealtime();
+  /// Events the mapping thread left for the caller, appended to `result`.
+  void TakePendingEvents(FrameResult* result);
+  FrameResult WaitForMapping(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
+                             std::optional<LiveTracking> live);
+  void ForEachMapPointLocked(const std::function<void(const Eigen::Vector3f&)>& fn) const;
+  std::vector<std::uint8_t> EncodeMapBytesLocked() const;
   void StartKeyframe(const std::shared_ptr<const Frame>& frame, const Sim3d& S_w_kf,
                      InverseDepthMap map, FrameResult* result);
-  /// Freezes the current keyframe into the graph and runs the backend on it.
+  /// Freezes the current keyframe into the graph and runs the backend on it (real-time mode:
+  /// the backend part is deferred until the caller is released).
   void FinishCurrentKeyframe(FrameResult* result);
+  /// A keyframe frozen into the graph whose constraint search and optimisation are due.
+  struct FinishedKeyframe {
+    std::int64_t id = 0;
+    std::optional<std::int64_t> parent;  ///< set when it is new (odometry edge to add)
+    Sim3d S_parent_kf;
+  };
+  /// Constraint search, optimisation and place recognition for a finished keyframe.
+  void RunBackend(const FinishedKeyframe& finished, FrameResult* result);
+  /// Real-time mode, after a mapped frame's result is handed back: the deferred backend work.
+  void RunDeferredBackend();
   /// Adds an optimisation to the backend statistics.
   void CountOptimisation(const PoseGraphSummary& summary);
   /// Place recognition for the finished keyframe `id` (its entry in the database); a
@@ -403,6 +488,17 @@ class System {
   /// Auto: the first good pair, held until the random start has converged (or failed) and
   /// either agrees with it or is replaced by it.
   std::optional<std::pair<std::shared_ptr<const Frame>, TwoViewPair>> pending_pair_;
+  /// Locks: engine_mutex_ (everything the mapping stages touch) before poses_mutex_
+  /// (frame_poses_, frame_timestamps_, pending_events_); the live tracker's own state is
+  /// the caller's. In the deterministic mode they are uncontended.
+  mutable std::mutex engine_mutex_;
+  mutable std::mutex poses_mutex_;
+  /// Real-time mode: finished keyframes waiting for the backend (mapping thread only).
+  std::vector<FinishedKeyframe> deferred_backend_;
+  /// Events of frames mapped behind the caller, for its next result.
+  std::vector<SystemEvent> pending_events_;
+  std::unique_ptr<LiveTracker> live_;      ///< real-time mode only
+  std::unique_ptr<MappingWorker> worker_;  ///< real-time mode only; destroyed first
 };
 
 }  // namespace parallax

@@ -29,6 +29,11 @@ std::string CameraText(const PinholeCamera& c) {
 }  // namespace
 
 std::vector<std::uint8_t> System::EncodeMapBytes() const {
+  const std::lock_guard<std::mutex> lock(engine_mutex_);
+  return EncodeMapBytesLocked();
+}
+
+std::vector<std::uint8_t> System::EncodeMapBytesLocked() const {
   if (start_ != StartState::kInitialised) {
     throw std::logic_error(start_ == StartState::kRelocalising
                                ? "no map to save: the loaded map has not been relocalised yet"
@@ -75,6 +80,7 @@ void System::LoadMap(const std::string& path) {
 }
 
 void System::LoadMapBytes(std::span<const std::uint8_t> bytes, const std::string& source) {
+  const std::lock_guard<std::mutex> lock(engine_mutex_);
   if (frame_count_ != first_frame_id_) {
     throw std::logic_error("a map can only be loaded before the first frame");
   }

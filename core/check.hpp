@@ -12,6 +12,12 @@ inline void CheckArgument(bool condition, const std::string& message) {
   if (!condition) throw std::invalid_argument(message);
 }
 
+/// Throws std::logic_error(message) unless condition holds (a call the object's state does
+/// not allow).
+inline void CheckState(bool condition, const std::string& message) {
+  if (!condition) throw std::logic_error(message);
+}
+
 /// Check for one field of an options struct: the message reads "<Struct>.<field> <rule>".
 inline void CheckOption(bool condition, const char* struct_name, const char* field,
                         const std::string& rule) {

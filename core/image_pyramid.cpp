@@ -92,8 +92,8 @@ ImagePyramid::ImagePyramid(const ImageView<std::uint8_t>& image, const PyramidOp
     total += kPlanes * static_cast<std::size_t>(image.Width() >> l) *
              static_cast<std::size_t>(image.Height() >> l);
   }
-  // Every element is written below, so skip value-initialisation.
-  buffer_ = std::make_unique_for_overwrite<float[]>(total);
+  // Every element is written below, so a recycled buffer needs no clearing.
+  buffer_ = FloatBufferPool::Shared().Take(total);
   std::vector<std::array<Plane, kPlanes>> planes(static_cast<std::size_t>(num_levels));
   for (std::size_t l = 0; l < planes.size(); ++l) {
     const int w = image.Width() >> l;

@@ -4,6 +4,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/buffer_pool.hpp"
 #include "core/image.hpp"
 
 namespace parallax {
@@ -54,7 +55,7 @@ class ImagePyramid {
   const PyramidLevel& Level(int level) const { return levels_[static_cast<std::size_t>(level)]; }
 
  private:
-  std::unique_ptr<float[]> buffer_;
+  FloatBufferPool::Buffer buffer_;  ///< from FloatBufferPool::Shared()
   std::vector<PyramidLevel> levels_;
 };
 

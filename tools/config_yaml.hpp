@@ -12,7 +12,6 @@ namespace parallax {
 /// section or key, a value of the wrong type, or options that fail their Check().
 void ApplyConfigYaml(const std::string& path, SystemOptions* options);
 /// The same for YAML text (the C API's options); errors name `name` and the line.
-void ApplyConfigYamlText(const std::string& text, const std::string& name,
-                         SystemOptions* options);
+void ApplyConfigYamlText(const std::string& text, const std::string& name, SystemOptions* options);
 
 }  // namespace parallax

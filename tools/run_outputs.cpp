@@ -92,11 +92,21 @@ void WriteStats(const std::string& path, const RunSummary& s) {
       {"fps", s.fps},
       {"tracking_ms", {{"p50", s.tracking_ms_p50}, {"p95", s.tracking_ms_p95}}},
       {"mapping_ms", {{"p50", s.mapping_ms_p50}, {"p95", s.mapping_ms_p95}}},
+      {"latency_ms",
+       {{"p50", s.latency_ms_p50}, {"p95", s.latency_ms_p95}, {"max", s.latency_ms_max}}},
       {"map_points", s.map_points},
       {"peak_rss_mb", s.peak_rss_mb}};
+  nlohmann::json all = j;
+  if (s.realtime) {
+    all["realtime"] = {{"rate", s.rate},
+                       {"frames_dropped", s.frames_dropped},
+                       {"frames_tracked_live", s.mapping.frames_tracked_live},
+                       {"frames_waiting_for_mapping", s.mapping.frames_mapped_waiting},
+                       {"frames_skipped_by_mapping", s.mapping.frames_skipped_by_mapping}};
+  }
   std::ofstream out(path);
   if (!out) throw InputError(path, "cannot open for writing");
-  out << j.dump(2) << "\n";
+  out << all.dump(2) << "\n";
 }
 
 std::string EventNames(const std::vector<SystemEvent>& events) {
@@ -191,6 +201,11 @@ void RunOutputs::LogUnreadable(int index, double timestamp, const std::string& u
   }
   frame_log_ << fmt::format("{},{},unreadable,0,0,0,0,{}\n", index, TimestampText(timestamp),
                             reason);
+  frame_log_.flush();
+}
+
+void RunOutputs::LogDropped(int index, double timestamp) {
+  frame_log_ << fmt::format("{},{},dropped,0,0,0,0,\n", index, TimestampText(timestamp));
   frame_log_.flush();
 }
 

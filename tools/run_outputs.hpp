@@ -25,6 +25,8 @@ class RunOutputs {
   /// so an interrupted or crashed run keeps them). `unreadable`: the reader's message.
   void LogFrame(int index, double timestamp, const FrameResult& result);
   void LogUnreadable(int index, double timestamp, const std::string& unreadable);
+  /// A frame the live camera replaced before tracking took it (real-time mode).
+  void LogDropped(int index, double timestamp);
 
   /// trajectory.txt, keyframes.txt, map.ply and stats.json from the map as it stands, then
   /// run.json with `status` ("complete", "interrupted" or "failed: <reason>").

@@ -13,6 +13,7 @@
 
 #include "core/check.hpp"
 #include "core/undistorter.hpp"
+#include "tools/dataset/camera_playback.hpp"
 #include "tools/dataset/frame_prefetcher.hpp"
 #include "tools/dataset/input_error.hpp"
 #include "tools/dataset/trajectory.hpp"
@@ -36,10 +37,15 @@ std::string RunSummary::Outcome() const {
 
 namespace {
 
+struct Timings {
+  std::vector<double> tracking_ms, mapping_ms, latency_ms;
+};
+
 /// Figures of the run so far (also for an interrupted or failed one).
-void Summarise(const System& system, const std::vector<double>& tracking_ms,
-               const std::vector<double>& mapping_ms, std::chrono::steady_clock::time_point start,
-               RunSummary* summary) {
+void Summarise(const System& system, const Timings& timings,
+               std::chrono::steady_clock::time_point start, RunSummary* summary) {
+  const std::vector<double>& tracking_ms = timings.tracking_ms;
+  const std::vector<double>& mapping_ms = timings.mapping_ms;
   summary->frames_tracked = static_cast<int>(system.Trajectory().size());
   summary->initialised_at_frame = system.InitialisedAtFrame();
   summary->frames_unusable = system.FramesUnusable();
@@ -70,6 +76,10 @@ void Summarise(const System& system, const std::vector<double>& tracking_ms,
   summary->maps = system.Graph().NumMaps();
   summary->maps_started = system.Backend().maps_started;
   summary->merges = system.Backend().merges;
+  summary->latency_ms_p50 = Percentile(timings.latency_ms, 0.5);
+  summary->latency_ms_p95 = Percentile(timings.latency_ms, 0.95);
+  summary->latency_ms_max = Percentile(timings.latency_ms, 1.0);
+  summary->mapping = system.Realtime();
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   summary->peak_rss_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;
@@ -77,54 +87,104 @@ void Summarise(const System& system, const std::vector<double>& tracking_ms,
 
 }  // namespace
 
+namespace {
+
+/// The frames as the run sees them: straight from the prefetcher, or through a live-camera
+/// playback in the real-time mode with a rate (dropped frames are logged as such).
+class FrameSource {
+ public:
+  FrameSource(FramePrefetcher* frames, const RunOptions& options)
+      : frames_(frames), first_(static_cast<std::size_t>(options.first_frame)) {
+    if (options.system.realtime.enabled && options.rate > 0.0) {
+      playback_ = std::make_unique<CameraPlayback>(frames, options.rate, first_);
+    }
+  }
+  std::optional<PreparedFrame> Next() {
+    if (playback_) return playback_->Next();
+    for (;;) {
+      auto frame = frames_->Next();
+      if (!frame || frame->index >= first_) return frame;
+    }
+  }
+  std::vector<std::pair<std::size_t, double>> TakeDropped() {
+    return playback_ ? playback_->TakeDropped() : std::vector<std::pair<std::size_t, double>>{};
+  }
+
+ private:
+  FramePrefetcher* frames_;
+  std::size_t first_;
+  std::unique_ptr<CameraPlayback> playback_;
+};
+
+}  // namespace
+
 RunSummary RunDataset(const RunOptions& options) {
   CheckArgument(options.max_frames >= 0, "--max-frames must be >= 0");
   CheckArgument(options.first_frame >= 0, "--first-frame must be >= 0");
+  CheckArgument(options.rate >= 0.0 && std::isfinite(options.rate), "--rate must be >= 0");
   const auto reader = OpenDataset(options.dataset, options.dataset_options);
   const Undistorter undistorter(reader->GetCamera(), reader->SuggestedRectification());
   System system(undistorter.OutputCamera(), options.system);
   if (!options.load_map.empty()) system.LoadMap(options.load_map);
   RunOutputs outputs(options.out_dir, options.trajectory_format, options.dataset);
-  std::vector<double> tracking_ms, mapping_ms;
+  Timings timings;
   RunSummary summary;
+  summary.realtime = options.system.realtime.enabled;
+  summary.rate = summary.realtime ? options.rate : 0.0;
   const auto start = std::chrono::steady_clock::now();
   const std::size_t num_frames = reader->NumFrames();  // the reader belongs to `frames` now
   FramePrefetcher frames(reader.get(), &undistorter, 4, !options.fatal_unreadable);
+  FrameSource source(&frames, options);
+  const auto log_dropped = [&] {
+    for (const auto& [index, timestamp] : source.TakeDropped()) {
+      ++summary.frames;
+      ++summary.frames_dropped;
+      outputs.LogDropped(static_cast<int>(index), timestamp);
+    }
+  };
   try {
     while (options.max_frames == 0 || summary.frames < options.max_frames) {
       if (options.stop && options.stop->load()) {
         summary.status = "interrupted";
         break;
       }
-      const auto frame = frames.Next();
+      const auto frame = source.Next();
+      log_dropped();
       if (!frame) break;
-      if (frame->index < static_cast<std::size_t>(options.first_frame)) continue;
       ++summary.frames;
       if (!frame->error.empty()) {
         ++summary.frames_unreadable;
         std::fprintf(stderr, "%sparallax: skipping frame %zu: %s\n", options.progress ? "\n" : "",
                      frame->index, frame->error.c_str());
-        outputs.LogUnreadable(summary.frames - 1, frame->timestamp, frame->error);
+        outputs.LogUnreadable(static_cast<int>(frame->index), frame->timestamp, frame->error);
         continue;
       }
+      const auto call = std::chrono::steady_clock::now();
       const FrameResult result = system.ProcessFrame(frame->image, frame->timestamp);
-      outputs.LogFrame(summary.frames - 1, frame->timestamp, result);
-      tracking_ms.push_back(result.tracking_ms);
-      mapping_ms.push_back(result.mapping_ms);
-      if (options.progress) {
+      timings.latency_ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - call)
+              .count());
+      outputs.LogFrame(static_cast<int>(frame->index), frame->timestamp, result);
+      timings.tracking_ms.push_back(result.tracking_ms);
+      timings.mapping_ms.push_back(result.mapping_ms);
+      if (options.progress && !summary.realtime) {
         std::fprintf(stderr, "\rframe %d/%zu  keyframes %zu  %s   ", summary.frames, num_frames,
                      system.Keyframes().size(), ToString(result.status).c_str());
       }
     }
+    // Interrupted: what mapping has not reached is dropped (the keyframes made are kept);
+    // otherwise every frame handed to mapping is mapped before the outputs.
+    summary.status == "interrupted" ? system.StopMapping() : system.FinishMapping();
   } catch (const std::exception& e) {
     // A fatal input error: what the map holds is still written, marked failed.
-    Summarise(system, tracking_ms, mapping_ms, start, &summary);
+    system.StopMapping();
+    Summarise(system, timings, start, &summary);
     outputs.Finish(system, &summary, std::string("failed: ") + e.what());
     throw;
   }
-  if (options.progress) std::fprintf(stderr, "\n");
+  if (options.progress && !summary.realtime) std::fprintf(stderr, "\n");
   if (summary.frames == 0) throw InputError(options.dataset, "has no frames");
-  Summarise(system, tracking_ms, mapping_ms, start, &summary);
+  Summarise(system, timings, start, &summary);
   outputs.Finish(system, &summary, summary.status);
   if (!options.save_map.empty()) system.SaveMap(options.save_map);
   return summary;

@@ -31,6 +31,10 @@ struct RunOptions {
   /// An unreadable or corrupt image is skipped and reported (frames.csv, stats.json); with
   /// this it ends the run instead (its outputs are still written, marked failed).
   bool fatal_unreadable = false;
+  /// Real-time mode (system.realtime.enabled): frames are played back at their timestamps
+  /// divided by this (CameraPlayback; frames arriving while tracking is busy are dropped);
+  /// 0 feeds them as fast as tracking takes them.
+  double rate = 1.0;
   /// Polled between frames: when it becomes true the run stops and writes its outputs from
   /// the map as it stands, marked interrupted (SIGINT/SIGTERM in `parallax run`).
   const std::atomic<bool>* stop = nullptr;
@@ -73,6 +77,13 @@ struct RunSummary {
   int maps = 0;                     ///< maps in the final graph (1 when every new map was merged)
   int maps_started = 0;             ///< new maps after long loss
   int merges = 0;
+  /// Wall time of each ProcessFrame call (what a caller waits for a pose), ms.
+  double latency_ms_p50 = 0.0, latency_ms_p95 = 0.0, latency_ms_max = 0.0;
+  /// Real-time mode only.
+  bool realtime = false;
+  double rate = 0.0;
+  int frames_dropped = 0;  ///< arrived while tracking was busy: never processed, no pose
+  RealtimeStats mapping;   ///< frames tracked live, waiting for mapping, skipped by mapping
 };
 
 /// Reads the dataset, rectifies each image, runs System::ProcessFrame, and writes

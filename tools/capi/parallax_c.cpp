@@ -95,8 +95,6 @@ px_status Create(const char* function, const px_camera* camera, const char* opti
     Require(out != nullptr, "out is NULL");
     Require(camera != nullptr, "camera is NULL");
     Require(realtime == 0 || realtime == 1, "realtime must be 0 or 1");
-    Require(realtime == 0,
-            "the real-time (threaded) mode is not implemented yet; create with realtime = 0");
     Require(camera->rectification == PX_RECTIFY_CROP || camera->rectification == PX_RECTIFY_FULL,
             "unknown rectification " + std::to_string(camera->rectification));
     SessionOptions options;
@@ -105,6 +103,7 @@ px_status Create(const char* function, const px_camera* camera, const char* opti
     if (options_yaml != nullptr) {
       ApplyConfigYamlText(options_yaml, "options_yaml", &options.system);
     }
+    options.system.realtime.enabled = realtime == 1;
     auto system = std::make_unique<px_system>();
     system->session = std::make_unique<Session>(CameraOf(*camera), options);
     *out = system.release();

@@ -104,12 +104,12 @@ px_frame_result Session::ProcessFrame(const std::uint8_t* gray, int width, int h
 }
 
 px_tracking_state Session::StateOf(const FrameResult& result) const {
-  if (!result.T_w_c) return system_->Initialising() ? PX_STATE_INITIALIZING : PX_STATE_LOST;
+  if (!result.T_w_c) return result.initialising ? PX_STATE_INITIALIZING : PX_STATE_LOST;
   const bool relocalised =
       std::any_of(result.events.begin(), result.events.end(),
                   [](const SystemEvent& e) { return e.kind == SystemEvent::Kind::kRelocalised; });
   if (relocalised) return PX_STATE_RELOCALIZED;
-  if (system_->Initialising()) return PX_STATE_INITIALIZING;
+  if (result.initialising) return PX_STATE_INITIALIZING;
   return result.status == TrackingStatus::kOk ? PX_STATE_TRACKING : PX_STATE_POOR;
 }
 
@@ -153,8 +153,7 @@ std::vector<px_keyframe> Session::Keyframes() const {
     k.timestamp_s = kf.timestamp;
     ToRowMajor(SE3d(kf.S_w_kf.Rotation(), kf.S_w_kf.Translation()), k.T_w_kf);
     k.scale = kf.S_w_kf.Scale();
-    k.map_id = system_->Graph().Contains(kf.frame_id) ? system_->Graph().MapOf(kf.frame_id)
-                                                      : system_->CurrentMap();
+    k.map_id = kf.map_id;
     out.push_back(k);
   }
   return out;

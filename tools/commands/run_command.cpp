@@ -38,7 +38,12 @@ void AddRunCommand(CLI::App& app, int* exit_code) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--config", *config,
                   "pipeline options, YAML (docs/configuration.md); several are applied in order");
-  cmd->add_flag("--realtime", *realtime, "threaded real-time mode (not implemented yet)");
+  cmd->add_flag("--realtime", *realtime,
+                "real-time mode: tracking on this thread, mapping on another (docs/realtime.md)");
+  cmd->add_option("--rate", options->rate,
+                  "--realtime: play frames at R x their timestamps (1: real time; 0: as fast as "
+                  "tracking goes); frames arriving while tracking is busy are dropped")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--fatal-unreadable", options->fatal_unreadable,
                 "an unreadable image ends the run (default: skipped and reported)");
   auto trajectory_format = std::make_shared<std::string>("tum");
@@ -60,9 +65,8 @@ void AddRunCommand(CLI::App& app, int* exit_code) {
     options->trajectory_format = *trajectory_format == "kitti"
                                      ? RunOptions::TrajectoryFormat::kKitti
                                      : RunOptions::TrajectoryFormat::kTum;
-    if (*realtime)
-      throw std::invalid_argument("--realtime is not implemented yet; the deterministic mode runs");
     for (const std::string& file : *config) ApplyConfigYaml(file, &options->system);
+    options->system.realtime.enabled = *realtime;
     if (*no_loop_closure) options->system.loop_closure.enabled = false;
     options->dataset_options.format = DatasetFormatFromString(*format);
     options->progress = isatty(STDERR_FILENO) != 0;

@@ -78,7 +78,10 @@ PX_API const char* px_status_string(px_status status);
 
 /* A system for undistorted images of `camera`. `options_yaml_or_null` holds options in the
  * sections and keys of `parallax run --config` (docs/configuration.md); NULL or "" keeps the
- * defaults. `realtime` must be 0 for now (the threaded mode is not implemented yet).
+ * defaults. `realtime` 0: deterministic (every stage runs inside process_frame; results
+ * are repeatable); 1: tracking inside process_frame, mapping and the backend on a thread
+ * the system owns (docs/realtime.md): process_frame answers at once, poses of earlier
+ * frames, keyframes and points follow as mapping catches up.
  * On failure *out is set to NULL. */
 PX_API px_status px_system_create(const px_pinhole* camera, const char* options_yaml_or_null,
                                   int realtime, px_system** out);

@@ -1,0 +1,39 @@
+#include "backend/live_tracker.hpp"
+
+namespace parallax {
+
+LiveSnapshot LiveTracker::Latest() {
+  const std::lock_guard<std::mutex> lock(mutex);
+  return snapshot;
+}
+
+void LiveTracker::Follow(const LiveSnapshot& s) {
+  // During the start the map may be replaced under the same keyframe id (a two-view pair
+  // replacing the random start rescales it; a restart): the mapping thread's state, which
+  // is at most a frame or two behind then, is the one to continue from.
+  if (!s.initialised || !followed_initialised) {
+    tracker.SetState(s.motion);
+    keyframe_id = s.keyframe_id;
+    followed_initialised = s.initialised;
+    return;
+  }
+  if (s.keyframe_id == keyframe_id) return;
+  if (keyframe_id < 0 || keyframe_id != s.previous_keyframe_id) {
+    tracker.SetState(s.motion);  // not the keyframe before: the mapping thread's state
+  } else {
+    const Sim3d& S_new_old = s.S_kf_previous;
+    MotionState m = tracker.State();
+    m.T_kf_last = (S_new_old * Sim3d(m.T_kf_last)).RigidPart();
+    m.T_prev_last = SE3d(m.T_prev_last.Rotation(), m.T_prev_last.Translation() * S_new_old.Scale());
+    m.frames_in_keyframe = s.motion.frames_in_keyframe;
+    tracker.SetState(m);
+  }
+  keyframe_id = s.keyframe_id;
+}
+void LiveTracker::Adopt(const LiveSnapshot& s) {
+  tracker.SetState(s.motion);
+  keyframe_id = s.usable ? s.keyframe_id : -1;
+  followed_initialised = s.initialised;
+}
+
+}  // namespace parallax

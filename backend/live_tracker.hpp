@@ -1,0 +1,57 @@
+#pragma once
+// Real-time mode, the caller's side (docs/realtime.md): the snapshot the mapping thread
+// publishes after every frame it maps, and the live tracker that reads it.
+
+#include <tbb/task_arena.h>
+
+#include <cstdint>
+#include <memory>
+#include <mutex>
+
+#include "backend/frame_tracker.hpp"
+#include "core/sim3.hpp"
+#include "tracking/tracking_reference.hpp"
+
+namespace parallax {
+
+/// What the mapping thread publishes for the live tracker after every frame it maps.
+struct LiveSnapshot {
+  bool usable = false;       ///< a current keyframe with depth to track against
+  bool initialised = false;  ///< ... and the start is complete (keyframes may be made)
+  std::int64_t keyframe_id = -1;
+  std::shared_ptr<const TrackingReference> reference;
+  Sim3d S_w_kf;
+  MotionState motion;  ///< the mapping thread's tracker after its last frame
+  /// The keyframe before the current one and its pose in the current one, taken together
+  /// with S_w_kf (an optimisation between two snapshots moves both).
+  std::int64_t previous_keyframe_id = -1;
+  Sim3d S_kf_previous;
+  double mean_idepth = 1.0;  ///< of the current keyframe (keyframe distance rule)
+};
+
+/// The caller's side: its own motion state, TBB arena and counters, and the snapshot.
+struct LiveTracker {
+  LiveTracker(const Se3TrackerOptions& options, int threads) : tracker(options), arena(threads) {}
+
+  FrameTracker tracker;
+  tbb::task_arena arena;
+  std::int64_t keyframe_id = -1;            ///< the keyframe `tracker`'s state is in
+  bool followed_initialised = false;        ///< the state adopted came from an initialised map
+  std::int64_t keyframe_requested_in = -1;  ///< a frame asked for a keyframe after this one
+  std::int64_t tracked_live = 0;
+  std::int64_t mapped_waiting = 0;
+  /// The mapping thread's: the keyframe of its last snapshot, and the one before it.
+  std::int64_t published_keyframe_id = -1;
+  std::int64_t published_previous_id = -1;
+  std::mutex mutex;  ///< guards `snapshot` (written by the mapping thread)
+  LiveSnapshot snapshot;
+
+  LiveSnapshot Latest();
+  /// The state continues in the published keyframe: a new keyframe re-expresses the last
+  /// pose and velocity through the keyframes' similarity (velocity in the new depth unit).
+  void Follow(const LiveSnapshot& s);
+  /// After the mapping thread tracked a frame itself, its state is the newest.
+  void Adopt(const LiveSnapshot& s);
+};
+
+}  // namespace parallax

@@ -1,0 +1,129 @@
+#include "backend/mapping_worker.hpp"
+
+#include <algorithm>
+
+#include "core/check.hpp"
+
+namespace parallax {
+
+MappingWorker::MappingWorker(Process process, FollowUp follow_up, std::size_t max_pending,
+                             int threads)
+    : process_(std::move(process)),
+      follow_up_(std::move(follow_up)),
+      max_pending_(max_pending),
+      arena_(threads) {
+  CheckArgument(max_pending_ >= 1, "MappingWorker: max_pending must be >= 1");
+  thread_ = std::thread([this] { Loop(); });
+}
+
+MappingWorker::~MappingWorker() { Stop(); }
+
+void MappingWorker::RethrowFailure() {
+  if (failure_) std::rethrow_exception(std::exchange(failure_, nullptr));
+}
+
+void MappingWorker::Offer(MappingJob job, bool wait_for_room) {
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    const auto refinements = [this] {
+      return static_cast<std::size_t>(
+          std::count_if(queue_.begin(), queue_.end(), [](const Entry& e) { return Skippable(e); }));
+    };
+    if (wait_for_room) {
+      idle_.wait(lock, [&] { return refinements() < max_pending_ || stopping_ || failure_; });
+    }
+    RethrowFailure();
+    CheckState(!stopping_, "MappingWorker::Offer: stopped");
+    if (refinements() >= max_pending_) {
+      // The newest frame refines better than an older one mapping has not reached.
+      queue_.erase(
+          std::find_if(queue_.begin(), queue_.end(), [](const Entry& e) { return !e.done; }));
+      ++skipped_;
+    }
+    queue_.push_back({std::move(job), nullptr});
+  }
+  wake_.notify_one();
+}
+
+FrameResult MappingWorker::Run(MappingJob job) {
+  auto done = std::make_shared<std::promise<FrameResult>>();
+  std::future<FrameResult> result = done->get_future();
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    RethrowFailure();
+    CheckState(!stopping_, "MappingWorker::Run: stopped");
+    queue_.push_back({std::move(job), std::move(done)});
+  }
+  wake_.notify_one();
+  return result.get();
+}
+
+void MappingWorker::Drain() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  idle_.wait(lock, [this] { return (queue_.empty() && !busy_) || stopping_; });
+  RethrowFailure();
+}
+
+void MappingWorker::Stop() {
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (stopping_ && !thread_.joinable()) return;
+    stopping_ = true;
+    queue_.clear();  // waiting refinements only: the caller is not waiting on any job now
+  }
+  wake_.notify_all();
+  idle_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+std::int64_t MappingWorker::Skipped() const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return skipped_;
+}
+
+void MappingWorker::Loop() {
+  for (;;) {
+    Entry entry;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+      if (stopping_) return;
+      entry = std::move(queue_.front());
+      queue_.pop_front();
+      busy_ = true;
+    }
+    const bool waited = entry.done != nullptr;
+    std::exception_ptr error;
+    std::exception_ptr follow_up_error;
+    std::optional<FrameResult> result;
+    arena_.execute([&] {
+      try {
+        result = process_(entry.job);
+      } catch (...) {
+        error = std::current_exception();
+      }
+    });
+    if (entry.done) {
+      error ? entry.done->set_exception(error) : entry.done->set_value(std::move(*result));
+      entry.done.reset();
+    }
+    if (!error && follow_up_) {
+      arena_.execute([&] {
+        try {
+          follow_up_();
+        } catch (...) {
+          follow_up_error = std::current_exception();
+        }
+      });
+    }
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      if (error && !waited) failure_ = error;
+      if (follow_up_error) failure_ = follow_up_error;
+      busy_ = false;
+    }
+    idle_.notify_all();
+  }
+}
+
+}  // namespace parallax

@@ -1,0 +1,96 @@
+#pragma once
+// The mapping thread of the real-time mode (docs/realtime.md): frames tracked live on the
+// caller's thread come here to refine depth, make keyframes and run the backend. A bounded
+// queue with condition variables; when mapping falls behind, the oldest waiting refinement
+// is skipped for the newest. Jobs the caller waits for are never skipped.
+
+#include <tbb/task_arena.h>
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <exception>
+#include <functional>
+#include <future>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "backend/frame_tracker.hpp"
+#include "backend/system.hpp"
+#include "core/frame.hpp"
+#include "core/image.hpp"
+
+namespace parallax {
+
+/// What the live tracker found for a frame, in the keyframe it tracked against.
+struct LiveTracking {
+  std::int64_t keyframe_id = -1;
+  TrackingResult tracked;
+  MotionState motion;  ///< the live tracker's state after this frame
+};
+
+/// A frame for the mapping thread; `live` is empty when the mapping thread must track it
+/// itself (the start, a lost frame).
+struct MappingJob {
+  std::shared_ptr<const Frame> frame;
+  ImageU8 image;  ///< the undistorted 8-bit image
+  std::optional<LiveTracking> live;
+  bool caller_waits = false;  ///< its result goes back to the caller (not to pending events)
+  bool keep = false;          ///< never skipped (it asks for a new keyframe)
+};
+
+class MappingWorker {
+ public:
+  using Process = std::function<FrameResult(const MappingJob&)>;
+  using FollowUp = std::function<void()>;
+
+  /// `process` maps a job; `follow_up` runs after each job's result was handed back (work
+  /// the caller need not wait for). `max_pending`: refinement jobs that may wait (>= 1);
+  /// `threads`: the TBB concurrency of the thread's arena. The thread starts here.
+  MappingWorker(Process process, FollowUp follow_up, std::size_t max_pending, int threads);
+  /// Stop().
+  ~MappingWorker();
+  MappingWorker(const MappingWorker&) = delete;
+  MappingWorker& operator=(const MappingWorker&) = delete;
+
+  /// Queues a refinement; when max_pending already wait, the oldest of them is skipped, or,
+  /// with `wait_for_room`, the call waits until mapping takes one (the start: its depth
+  /// converges only from the frames it maps). Rethrows (once) an exception an earlier
+  /// refinement threw.
+  void Offer(MappingJob job, bool wait_for_room = false);
+  /// Queues a job behind the waiting ones and returns its result (rethrowing its exception).
+  FrameResult Run(MappingJob job);
+  /// Returns once every queued job is done (rethrows as Offer does).
+  void Drain();
+  /// Drops the waiting jobs, lets the running one finish and joins the thread. Idempotent.
+  void Stop();
+  /// Refinements skipped because mapping was behind.
+  std::int64_t Skipped() const;
+
+ private:
+  struct Entry {
+    MappingJob job;
+    std::shared_ptr<std::promise<FrameResult>> done;  ///< set for jobs the caller waits for
+  };
+  static bool Skippable(const Entry& e) { return !e.done && !e.job.keep; }
+  void Loop();
+  void RethrowFailure();  // precondition: mutex_ held
+
+  Process process_;
+  FollowUp follow_up_;
+  std::size_t max_pending_;
+  tbb::task_arena arena_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;  ///< a job was queued, or stop
+  std::condition_variable idle_;  ///< a job finished
+  std::deque<Entry> queue_;
+  bool busy_ = false;
+  bool stopping_ = false;
+  std::exception_ptr failure_;
+  std::int64_t skipped_ = 0;
+  std::thread thread_;  ///< last: started when everything above exists
+};
+
+}  // namespace parallax
