@@ -139,9 +139,9 @@ TEST(Realtime, AnOrbitFedAsFastAsTrackingGoesIsPosedInOneWorld) {
 }
 
 TEST(Realtime, SystemsStoppedOrDestroyedMidStreamKeepTheirKeyframes) {
-  for (int round = 0; round < 6; ++round) {
+  for (int round = 0; round < 4; ++round) {
     System system(test::TestCamera(), Realtime());
-    const int frames = 20 + 7 * round;
+    const int frames = 20 + 8 * round;
     for (int k = 0; k < frames; ++k) {
       system.ProcessFrame(test::RenderTestImage(Room(), OrbitPose(k)), k / 30.0);
     }
@@ -156,9 +156,11 @@ TEST(Realtime, SystemsStoppedOrDestroyedMidStreamKeepTheirKeyframes) {
 
 TEST(Realtime, SeveralThreadsFeedSeveralSystems) {
   std::vector<ImageU8> images;
+  images.reserve(40);
   for (int k = 0; k < 40; ++k) images.push_back(test::RenderTestImage(Room(), OrbitPose(k)));
   std::atomic<int> posed{0};
   std::vector<std::thread> feeders;
+  feeders.reserve(3);
   for (int t = 0; t < 3; ++t) {
     feeders.emplace_back([&] {
       System system(test::TestCamera(), Realtime());
