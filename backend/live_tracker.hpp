@@ -26,7 +26,8 @@ struct LiveSnapshot {
   /// with S_w_kf (an optimisation between two snapshots moves both).
   std::int64_t previous_keyframe_id = -1;
   Sim3d S_kf_previous;
-  double mean_idepth = 1.0;  ///< of the current keyframe (keyframe distance rule)
+  double mean_idepth = 1.0;      ///< of the current keyframe (keyframe distance rule)
+  std::uint64_t generation = 0;  ///< System::map_generation_
 };
 
 /// The caller's side: its own motion state, TBB arena and counters, and the snapshot.

@@ -28,7 +28,8 @@ namespace parallax {
 struct LiveTracking {
   std::int64_t keyframe_id = -1;
   TrackingResult tracked;
-  MotionState motion;  ///< the live tracker's state after this frame
+  MotionState motion;            ///< the live tracker's state after this frame
+  std::uint64_t generation = 0;  ///< of the map it tracked against (System::map_generation_)
 };
 
 /// A frame for the mapping thread; `live` is empty when the mapping thread must track it
@@ -39,6 +40,9 @@ struct MappingJob {
   std::optional<LiveTracking> live;
   bool caller_waits = false;  ///< its result goes back to the caller (not to pending events)
   bool keep = false;          ///< never skipped (it asks for a new keyframe)
+  /// A frame the live tracker lost: its motion state after its last good frame, which is
+  /// newer than the mapping thread's when mapping skipped frames (keyframe_id -1: none).
+  LiveTracking hint;
 };
 
 class MappingWorker {

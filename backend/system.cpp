@@ -210,6 +210,7 @@ void System::ClearMap() {
   }
   mapper_.Clear();
   current_ = CurrentKeyframe{};
+  ++map_generation_;
 }
 
 FrameResult System::ProcessFrame(const ImageU8& image, double timestamp) {
@@ -311,9 +312,9 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& 
       start_ == StartState::kRandomPairSearch || start_ == StartState::kRandomPairHeld;
   const bool view_degrades = tracked.stats.usage < options_.min_keyframe_usage ||
                              tracked.stats.good_ratio < options_.min_keyframe_good_ratio;
-  const bool want_keyframe =
-      !start_pending && tracker_.State().frames_in_keyframe >= options_.min_frames_per_keyframe &&
-      (view_degrades || relative_distance > options_.keyframe_distance);
+  bool want_keyframe = !start_pending &&
+                       tracker_.State().frames_in_keyframe >= options_.min_frames_per_keyframe &&
+                       (view_degrades || relative_distance > options_.keyframe_distance);
   if (tracked.status == TrackingStatus::kOk && relative_distance > options_.min_update_baseline) {
     // Only once initialised: the start's keyframe and its selection stay as they were.
     const bool initialised = start_ == StartState::kInitialised;
@@ -421,6 +422,7 @@ FrameResult System::StartNewMap(const std::shared_ptr<const Frame>& frame, const
   FinishCurrentKeyframe(&finished);
   mapper_.Clear();
   current_ = CurrentKeyframe{};
+  ++map_generation_;
   current_map_ = next_map_++;
   ++backend_stats_.maps_started;
   start_ = StartState::kNoKeyframe;

@@ -332,7 +332,7 @@ class System {
   /// Events the mapping thread left for the caller, appended to `result`.
   void TakePendingEvents(FrameResult* result);
   FrameResult WaitForMapping(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
-                             std::optional<LiveTracking> live);
+                             std::optional<LiveTracking> live, LiveTracking hint);
   void ForEachMapPointLocked(const std::function<void(const Eigen::Vector3f&)>& fn) const;
   std::vector<std::uint8_t> EncodeMapBytesLocked() const;
   void StartKeyframe(const std::shared_ptr<const Frame>& frame, const Sim3d& S_w_kf,
@@ -493,6 +493,10 @@ class System {
   /// the caller's. In the deterministic mode they are uncontended.
   mutable std::mutex engine_mutex_;
   mutable std::mutex poses_mutex_;
+  /// Changes whenever the current keyframe's depth may be replaced or rescaled as a whole
+  /// (the start completing, a restart, a new map): live tracking of an older generation is
+  /// not used for depth updates (real-time mode).
+  std::uint64_t map_generation_ = 0;
   /// Real-time mode: finished keyframes waiting for the backend (mapping thread only).
   std::vector<FinishedKeyframe> deferred_backend_;
   /// Events of frames mapped behind the caller, for its next result.

@@ -111,8 +111,9 @@ std::vector<RevisedPose> System::FinishInitialisation() {
   initial_frames_.clear();
   bootstrap_.reset();
   start_ = StartState::kInitialised;
+  ++map_generation_;
   if (initialised_at_frame_ < 0) {  // the first map's
-    initialised_at_frame_ = static_cast<int>(frame_count_ - 1 - first_frame_id_);
+    initialised_at_frame_ = static_cast<int>(result_frame_id_ - first_frame_id_);
   }
   return revised;
 }

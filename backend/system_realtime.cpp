@@ -66,8 +66,8 @@ void System::TakePendingEvents(FrameResult* result) {
 }
 
 FrameResult System::WaitForMapping(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
-                                   std::optional<LiveTracking> live) {
-  MappingJob job{frame, image, std::move(live), true};
+                                   std::optional<LiveTracking> live, LiveTracking hint) {
+  MappingJob job{frame, image, std::move(live), true, false, std::move(hint)};
   FrameResult result = worker_->Run(std::move(job));
   ++live_->mapped_waiting;
   live_->Adopt(live_->Latest());
@@ -81,15 +81,20 @@ FrameResult System::ProcessLive(std::int64_t id, double timestamp, const ImageU8
     frame = std::make_shared<const Frame>(id, timestamp, camera_, image, options_.pyramid);
   });
   const LiveSnapshot snapshot = live_->Latest();
-  if (!snapshot.usable) return WaitForMapping(frame, image, std::nullopt);
+  if (!snapshot.usable) return WaitForMapping(frame, image, std::nullopt, LiveTracking{});
   live_->Follow(snapshot);
   const auto start = Clock::now();
   TrackingResult tracked;
   live_->arena.execute([&] { tracked = live_->tracker.Track(*snapshot.reference, *frame); });
   const double tracking_ms = MillisecondsSince(start);
-  // Lost: the mapping thread tries recent keyframes and relocalisation with the whole map.
-  if (tracked.status == TrackingStatus::kLost) return WaitForMapping(frame, image, std::nullopt);
-  LiveTracking live{snapshot.keyframe_id, tracked, live_->tracker.State()};
+  // Lost: the mapping thread tracks it again from the live tracker's motion, then tries the
+  // recent keyframes and relocalisation with the whole map.
+  if (tracked.status == TrackingStatus::kLost) {
+    return WaitForMapping(
+        frame, image, std::nullopt,
+        LiveTracking{snapshot.keyframe_id, tracked, live_->tracker.State(), snapshot.generation});
+  }
+  LiveTracking live{snapshot.keyframe_id, tracked, live_->tracker.State(), snapshot.generation};
   // The keyframe rule of MapFrame: a frame that wants a new keyframe is never skipped by
   // mapping (once per keyframe); tracking goes on against the current one meanwhile, which
   // still tracks (the rule fires well before the view is lost), and follows the new one
@@ -108,7 +113,7 @@ FrameResult System::ProcessLive(std::int64_t id, double timestamp, const ImageU8
        tracked.stats.usage * f < options_.min_keyframe_usage ||
        tracked.stats.good_ratio * f < options_.min_keyframe_good_ratio)) {
     // The requested keyframe is overdue: this frame is mapped (and tracked again) after it.
-    FrameResult result = WaitForMapping(frame, image, std::nullopt);
+    FrameResult result = WaitForMapping(frame, image, std::nullopt, LiveTracking{});
     result.tracking_ms += tracking_ms;
     return result;
   }
@@ -120,7 +125,8 @@ FrameResult System::ProcessLive(std::int64_t id, double timestamp, const ImageU8
   result.anchor = AnchoredPose{snapshot.keyframe_id, tracked.T_kf_frame};
   result.T_w_c = (snapshot.S_w_kf * Sim3d(tracked.T_kf_frame)).RigidPart();
   Record(frame->Id(), result);
-  worker_->Offer(MappingJob{frame, image, std::move(live), false, keep}, !snapshot.initialised);
+  worker_->Offer(MappingJob{frame, image, std::move(live), false, keep, LiveTracking{}},
+                 !snapshot.initialised);
   ++live_->tracked_live;
   TakePendingEvents(&result);
   return result;
@@ -143,6 +149,10 @@ FrameResult System::MapJob(const MappingJob& job) {
     last_posed_timestamp_ = job.frame->Timestamp();
     Record(job.frame->Id(), result);
   } else {
+    if (job.hint.keyframe_id >= 0 && job.hint.keyframe_id == current_.id &&
+        job.hint.generation == map_generation_ && start_ == StartState::kInitialised) {
+      tracker_.SetState(job.hint.motion);
+    }
     result = ProcessInOrder(job.frame, job.image);
     // A frame the caller already has a pose for keeps it when tracking it again here failed.
     if (!result.T_w_c && job.live && !job.caller_waits) {
@@ -174,13 +184,12 @@ void System::RunDeferredBackend() {
 
 void System::PublishLive() {
   LiveSnapshot s;
-  // The random start tracks from its first frame (docs/realtime.md): the live tracker may
-  // too, with provisional poses; the two-view search has no depth to track against.
+  // The start runs on the mapping thread with the caller waiting, frame by frame as in the
+  // deterministic mode: its second tracking revises the poses of exactly the frames it saw,
+  // and it may replace or rescale the map (measured: live tracking during the start left
+  // the TUM clip at 31 mm against 6 mm).
   s.initialised = start_ == StartState::kInitialised;
-  s.usable = mapper_.HasMap() &&
-             (s.initialised || start_ == StartState::kConverging ||
-              start_ == StartState::kRandomPairSearch || start_ == StartState::kRandomPairHeld);
-  s.motion = tracker_.State();
+  s.usable = s.initialised && mapper_.HasMap();
   if (s.usable) {
     s.keyframe_id = current_.id;
     s.reference = mapper_.Reference();
