@@ -137,7 +137,8 @@ FrameResult System::MapJob(const MappingJob& job) {
   const auto start = Clock::now();
   FrameResult result;
   const bool same_keyframe = job.live && start_ == StartState::kInitialised && mapper_.HasMap() &&
-                             job.live->keyframe_id == current_.id;
+                             job.live->keyframe_id == current_.id &&
+                             job.live->generation == map_generation_;
   if (same_keyframe) {
     // The live tracker's result is this thread's: no second tracking of the frame.
     result_frame_id_ = job.frame->Id();
@@ -190,6 +191,8 @@ void System::PublishLive() {
   // the TUM clip at 31 mm against 6 mm).
   s.initialised = start_ == StartState::kInitialised;
   s.usable = s.initialised && mapper_.HasMap();
+  s.motion = tracker_.State();
+  s.generation = map_generation_;
   if (s.usable) {
     s.keyframe_id = current_.id;
     s.reference = mapper_.Reference();
