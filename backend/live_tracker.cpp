@@ -1,5 +1,7 @@
 #include "backend/live_tracker.hpp"
 
+#include <optional>
+
 namespace parallax {
 
 LiveSnapshot LiveTracker::Latest() {
@@ -18,13 +20,20 @@ void LiveTracker::Follow(const LiveSnapshot& s) {
     return;
   }
   if (s.keyframe_id == keyframe_id) return;
-  if (keyframe_id < 0 || keyframe_id != s.previous_keyframe_id) {
-    tracker.SetState(s.motion);  // not the keyframe before: the mapping thread's state
+  // The live state's keyframe in the new one: directly, or through the world poses of
+  // the newest keyframes; otherwise the mapping thread's (older) state.
+  std::optional<Sim3d> S_new_old;
+  if (keyframe_id >= 0 && keyframe_id == s.previous_keyframe_id) S_new_old = s.S_kf_previous;
+  for (const auto& [id, S_w_old] : s.recent_poses) {
+    if (!S_new_old && id == keyframe_id) S_new_old = s.S_w_kf.Inverse() * S_w_old;
+  }
+  if (!S_new_old) {
+    tracker.SetState(s.motion);
   } else {
-    const Sim3d& S_new_old = s.S_kf_previous;
     MotionState m = tracker.State();
-    m.T_kf_last = (S_new_old * Sim3d(m.T_kf_last)).RigidPart();
-    m.T_prev_last = SE3d(m.T_prev_last.Rotation(), m.T_prev_last.Translation() * S_new_old.Scale());
+    m.T_kf_last = (*S_new_old * Sim3d(m.T_kf_last)).RigidPart();
+    m.T_prev_last =
+        SE3d(m.T_prev_last.Rotation(), m.T_prev_last.Translation() * S_new_old->Scale());
     m.frames_in_keyframe = s.motion.frames_in_keyframe;
     tracker.SetState(m);
   }

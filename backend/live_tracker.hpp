@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <utility>
+#include <vector>
 
 #include "backend/frame_tracker.hpp"
 #include "core/sim3.hpp"
@@ -26,6 +28,9 @@ struct LiveSnapshot {
   /// with S_w_kf (an optimisation between two snapshots moves both).
   std::int64_t previous_keyframe_id = -1;
   Sim3d S_kf_previous;
+  /// World poses of the newest finished keyframes (taken with S_w_kf), so that the live
+  /// state can follow over several keyframe changes it did not see.
+  std::vector<std::pair<std::int64_t, Sim3d>> recent_poses;
   double mean_idepth = 1.0;      ///< of the current keyframe (keyframe distance rule)
   std::uint64_t generation = 0;  ///< System::map_generation_
 };

@@ -203,6 +203,12 @@ void System::PublishLive() {
       live_->published_keyframe_id = s.keyframe_id;
     }
     const std::int64_t previous = live_->published_previous_id;
+    const std::vector<std::int64_t> ids = graph_.Ids();
+    constexpr std::size_t kRecentPoses = 8;
+    for (std::size_t k = ids.size() > kRecentPoses ? ids.size() - kRecentPoses : 0; k < ids.size();
+         ++k) {
+      s.recent_poses.emplace_back(ids[k], graph_.Pose(ids[k]));
+    }
     if (previous >= 0 && graph_.Contains(previous)) {
       s.previous_keyframe_id = previous;
       s.S_kf_previous = s.S_w_kf.Inverse() * graph_.Pose(previous);
