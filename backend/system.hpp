@@ -61,6 +61,9 @@ struct RealtimeOptions {
   /// keyframe exists, tracking waits for it (unthrottled input would otherwise outrun the
   /// map: measured 12.9% of path on a 300-frame orbit without the wait).
   double keyframe_wait_factor = 1.5;
+  /// The snapshot carries the world poses of this many newest finished keyframes, so that
+  /// the live state can follow keyframe changes it did not see (docs/realtime.md).
+  int snapshot_keyframe_poses = 8;
 
   void Check() const;
 };

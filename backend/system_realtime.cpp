@@ -27,6 +27,8 @@ void RealtimeOptions::Check() const {
   CheckOption(opencv_threads >= 1, "RealtimeOptions", "opencv_threads", "must be >= 1");
   CheckOption(keyframe_wait_factor >= 1.0, "RealtimeOptions", "keyframe_wait_factor",
               "must be >= 1");
+  CheckOption(snapshot_keyframe_poses >= 0, "RealtimeOptions", "snapshot_keyframe_poses",
+              "must be >= 0");
 }
 
 void System::StartRealtime() {

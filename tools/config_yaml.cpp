@@ -126,6 +126,13 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"max_reprojection_px", Set(&o->relocalization.max_reprojection_px)},
         {"ransac_iterations", Set(&o->relocalization.ransac_iterations)},
         {"max_relative_depth_std", Set(&o->relocalization.max_relative_depth_std)}}},
+      {"realtime",
+       {{"max_pending_frames", Set(&o->realtime.max_pending_frames)},
+        {"tracking_threads", Set(&o->realtime.tracking_threads)},
+        {"mapping_threads", Set(&o->realtime.mapping_threads)},
+        {"opencv_threads", Set(&o->realtime.opencv_threads)},
+        {"keyframe_wait_factor", Set(&o->realtime.keyframe_wait_factor)},
+        {"snapshot_keyframe_poses", Set(&o->realtime.snapshot_keyframe_poses)}}},
   };
 }
 
@@ -142,7 +149,7 @@ void ApplyConfigRoot(const YAML::Node& root, const std::string& path, SystemOpti
       throw InputError(path, LineOf(section.first),
                        "unknown section '" + name +
                            "' (expected pyramid, reference, tracker, depth, system, backend, "
-                           "loop_closure or relocalization)");
+                           "loop_closure, relocalization or realtime)");
     }
     if (!section.second.IsMap())
       throw InputError(path, LineOf(section.second), "section '" + name + "' must be a mapping");

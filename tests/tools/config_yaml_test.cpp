@@ -26,6 +26,23 @@ TEST(ConfigYaml, OverridesOnlyTheGivenKeys) {
   EXPECT_EQ(options.depth.seed, 7u);
 }
 
+TEST(ConfigYaml, TextGetsTheSameKeysAndErrorsWithItsName) {
+  SystemOptions options;
+  ApplyConfigYamlText("realtime:\n  max_pending_frames: 3\n  keyframe_wait_factor: 2.0\n",
+                      "options_yaml", &options);
+  EXPECT_EQ(options.realtime.max_pending_frames, 3);
+  EXPECT_DOUBLE_EQ(options.realtime.keyframe_wait_factor, 2.0);
+  EXPECT_FALSE(options.realtime.enabled);  // the mode is the caller's flag, not an option
+  try {
+    ApplyConfigYamlText("realtime:\n  mapping_threads: 0\n", "options_yaml", &options);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("options_yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("mapping_threads"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(options.realtime.mapping_threads, 1);  // a refused text changes nothing
+}
+
 TEST(ConfigYaml, ErrorsNameFileLineAndKey) {
   test::TempDir dir;
   SystemOptions options;
