@@ -215,19 +215,7 @@ std::vector<std::uint8_t> EncodeMap(const PinholeCamera& camera, const KeyframeG
 
 MapContents DecodeMap(std::span<const std::uint8_t> bytes, const std::string& source) {
   Reader r(bytes, source);
-  char magic[sizeof(kMagic)];
-  r.GetBytes(magic, sizeof(magic), "magic");
-  if (std::memcmp(magic, kMagic, sizeof(kMagic)) != 0) r.Fail("not a Parallax map file");
-  std::uint32_t stored = 0;
-  std::memcpy(&stored, bytes.data() + bytes.size() - 4, 4);  // at least the magic is there
-  if (stored != Crc32(bytes.first(bytes.size() - 4))) {
-    r.Fail("checksum mismatch (the file is corrupt or truncated)");
-  }
-  const auto version = r.Get<std::uint32_t>("format version");
-  if (version != kFormatVersion) {
-    r.Fail("format version " + std::to_string(version) + " (this build reads " +
-           std::to_string(kFormatVersion) + ")");
-  }
+  r.ReadHeader(kMagic, "map file", kFormatVersion);
   MapContents contents;
   contents.camera = GetCamera(&r);
   contents.next_frame_id = r.Get<std::int64_t>("next frame id");

@@ -105,21 +105,7 @@ std::vector<std::uint8_t> Vocabulary::ToBytes() const {
 
 Vocabulary Vocabulary::FromBytes(std::span<const std::uint8_t> bytes, const std::string& source) {
   ByteReader<VocabularyError> r(bytes, source);
-  char magic[sizeof(kMagic)];
-  r.GetBytes(magic, sizeof(magic), "magic");
-  if (std::memcmp(magic, kMagic, sizeof(kMagic)) != 0) r.Fail("not a Parallax vocabulary");
-  if (bytes.size() >= 4) {
-    std::uint32_t stored = 0;
-    std::memcpy(&stored, bytes.data() + bytes.size() - 4, 4);
-    if (stored != Crc32(bytes.first(bytes.size() - 4))) {
-      r.Fail("checksum mismatch (the file is corrupt or truncated)");
-    }
-  }
-  const auto version = r.Get<std::uint32_t>("format version");
-  if (version != kFormatVersion) {
-    r.Fail("format version " + std::to_string(version) + " (this build reads " +
-           std::to_string(kFormatVersion) + ")");
-  }
+  r.ReadHeader(kMagic, "vocabulary", kFormatVersion);
   Vocabulary v;
   const auto branching = r.Get<std::uint32_t>("branching");
   const auto depth = r.Get<std::uint32_t>("depth");

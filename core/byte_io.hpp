@@ -2,6 +2,7 @@
 // Little-endian binary writing and bounds-checked reading for the files Parallax writes
 // (vocabulary, maps). Readers throw with the source name and byte offset of the problem.
 
+#include <algorithm>
 #include <bit>
 #include <cstdint>
 #include <cstring>
@@ -10,6 +11,8 @@
 #include <string>
 #include <type_traits>
 #include <vector>
+
+#include "core/crc32.hpp"
 
 namespace parallax {
 
@@ -56,6 +59,24 @@ class ByteReader {
     Require(n, what);
     if (n > 0) std::memcpy(out, bytes_.data() + offset_, n);
     offset_ += n;
+  }
+  /// The header of a Parallax binary file: `magic`, a CRC-32 of everything before the
+  /// last four bytes (checked first, so that corruption reads as corruption), and a u32
+  /// format version that must equal `version`. `kind` names the file kind in messages.
+  void ReadHeader(std::span<const char> magic, const std::string& kind, std::uint32_t version) {
+    std::vector<char> found(magic.size());
+    GetBytes(found.data(), found.size(), "magic");
+    if (!std::equal(found.begin(), found.end(), magic.begin())) Fail("not a Parallax " + kind);
+    std::uint32_t stored = 0;
+    std::memcpy(&stored, bytes_.data() + bytes_.size() - 4, 4);  // the magic is longer
+    if (stored != Crc32(bytes_.first(bytes_.size() - 4))) {
+      Fail("checksum mismatch (the file is corrupt or truncated)");
+    }
+    const auto found_version = Get<std::uint32_t>("format version");
+    if (found_version != version) {
+      Fail("format version " + std::to_string(found_version) + " (this build reads " +
+           std::to_string(version) + ")");
+    }
   }
   std::size_t Offset() const { return offset_; }
   std::size_t Remaining() const { return bytes_.size() - offset_; }
