@@ -7,15 +7,12 @@
 #include <stdexcept>
 
 #include "core/check.hpp"
+#include "core/stopwatch.hpp"
 
 namespace parallax {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
+using Clock = StageClock;
 
 /// The graph flattened for one optimisation: vertices by position, free ones with a block.
 struct Problem {

@@ -6,15 +6,12 @@
 #include "backend/live_tracker.hpp"
 #include "backend/mapping_worker.hpp"
 #include "core/check.hpp"
+#include "core/stopwatch.hpp"
 
 namespace parallax {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
+using Clock = StageClock;
 
 }  // namespace
 

@@ -8,15 +8,12 @@
 #include "backend/mapping_worker.hpp"
 #include "backend/system.hpp"
 #include "core/check.hpp"
+#include "core/stopwatch.hpp"
 
 namespace parallax {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
+using Clock = StageClock;
 
 }  // namespace
 
