@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <stdexcept>
 
 #include "core/binary_file.hpp"
 #include "core/byte_io.hpp"
@@ -231,7 +232,14 @@ MapContents DecodeMap(std::span<const std::uint8_t> bytes, const std::string& so
     contents.graph.Poses().SetFixed(id, gauge);
   }
   const auto edges = r.Get<std::uint32_t>("edge count");
-  for (std::uint32_t k = 0; k < edges; ++k) contents.graph.AddEdge(GetEdge(&r, contents.graph));
+  for (std::uint32_t k = 0; k < edges; ++k) {
+    const PoseGraphEdge edge = GetEdge(&r, contents.graph);
+    try {  // the graph's own checks (symmetric, positive semi-definite) judge the information
+      contents.graph.AddEdge(edge);
+    } catch (const std::invalid_argument& e) {
+      r.Fail(e.what());
+    }
+  }
   r.Get<std::uint32_t>("checksum");
   if (r.Remaining() != 0) r.Fail("unexpected bytes after the checksum");
   return contents;

@@ -203,9 +203,8 @@ void System::PublishLive() {
     }
     const std::int64_t previous = live_->published_previous_id;
     const std::vector<std::int64_t> ids = graph_.Ids();
-    constexpr std::size_t kRecentPoses = 8;
-    for (std::size_t k = ids.size() > kRecentPoses ? ids.size() - kRecentPoses : 0; k < ids.size();
-         ++k) {
+    const auto recent = static_cast<std::size_t>(options_.realtime.snapshot_keyframe_poses);
+    for (std::size_t k = ids.size() > recent ? ids.size() - recent : 0; k < ids.size(); ++k) {
       s.recent_poses.emplace_back(ids[k], graph_.Pose(ids[k]));
     }
     if (previous >= 0 && graph_.Contains(previous)) {

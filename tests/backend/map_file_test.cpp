@@ -111,6 +111,20 @@ TEST(MapFile, DamagedFilesAreRejectedWithTheByteOfTheProblem) {
   std::memcpy(focal.data() + 8 + 4 + 8, &negative, sizeof(double));
   ResealCrc(&focal);
   ExpectRejected(focal, "negative focal length");
+  // The last edge's information (49 doubles before its kind and robust bytes and the CRC)
+  // made asymmetric, then indefinite, with a valid checksum: found by fuzz_map, which
+  // crashed on the exception the pose graph threw for it.
+  const std::size_t information = good.size() - 4 - 2 - 49 * sizeof(double);
+  std::vector<std::uint8_t> asymmetric = good;
+  const double large = 1e6;
+  std::memcpy(asymmetric.data() + information + sizeof(double), &large, sizeof(double));
+  ResealCrc(&asymmetric);
+  ExpectRejected(asymmetric, "asymmetric edge information");
+  std::vector<std::uint8_t> indefinite = good;
+  const double minus = -1.0;
+  std::memcpy(indefinite.data() + information, &minus, sizeof(double));
+  ResealCrc(&indefinite);
+  ExpectRejected(indefinite, "indefinite edge information");
 }
 
 TEST(MapFile, AMapOfAnotherCameraOrIntoAUsedSystemIsRefusedAndChangesNothing) {
