@@ -66,6 +66,32 @@ void KeyframeGraph::MergeMaps(int from, int into, const Sim3d& S_into_from) {
   }
 }
 
+void KeyframeGraph::AdoptOptimised(const KeyframeGraph& optimised, std::size_t edges_before) {
+  // Corrections first, from the poses both graphs still share.
+  std::map<int, std::int64_t> anchor;  // map -> its newest keyframe in the copy
+  for (const auto& [id, map] : map_of_) {
+    if (optimised.Contains(id)) anchor[map] = id;
+  }
+  for (auto& [id, map] : map_of_) {
+    if (optimised.Contains(id)) continue;
+    const auto a = anchor.find(map);
+    if (a == anchor.end()) continue;  // a map started since: nothing moved it
+    const Sim3d correction = optimised.Pose(a->second) * Pose(a->second).Inverse();
+    poses_.SetPose(id, correction * Pose(id));
+    if (optimised.MapOf(a->second) != map) poses_.SetFixed(id, false);  // merged away
+    map = optimised.MapOf(a->second);
+  }
+  for (auto& [id, map] : map_of_) {
+    if (!optimised.Contains(id)) continue;
+    poses_.SetVertex(id, optimised.Pose(id), optimised.Poses().IsFixed(id));
+    map = optimised.MapOf(id);
+  }
+  const std::vector<PoseGraphEdge>& edges = optimised.Poses().Edges();
+  for (std::size_t k = edges_before; k < edges.size(); ++k) {
+    if (Contains(edges[k].i) && Contains(edges[k].j)) poses_.AddEdge(edges[k]);
+  }
+}
+
 bool KeyframeGraph::HasEdge(std::int64_t a, std::int64_t b) const {
   return std::any_of(poses_.Edges().begin(), poses_.Edges().end(), [&](const PoseGraphEdge& e) {
     return (e.i == a && e.j == b) || (e.i == b && e.j == a);

@@ -84,6 +84,13 @@ class KeyframeGraph {
   /// Moves every keyframe of map `from` into map `into`: S_w_k <- S_into_from * S_w_k; its
   /// gauge is released (the merged graph keeps `into`'s).
   void MergeMaps(int from, int into, const Sim3d& S_into_from);
+  /// Takes the backend's result from `optimised`, a copy of this graph made when the
+  /// backend started (real-time mode: the mapping thread went on meanwhile). Keyframes in
+  /// both get its poses, gauges and maps; keyframes added since move with the newest
+  /// keyframe of their map in the copy (its correction applied to them, its map taken);
+  /// its edges from index `edges_before` on are added. The keyframe data stays this
+  /// graph's (a keyframe may have been compacted or replaced since).
+  void AdoptOptimised(const KeyframeGraph& optimised, std::size_t edges_before);
   bool Contains(std::int64_t id) const { return keyframes_.count(id) > 0; }
   /// Throws std::out_of_range for an unknown id.
   const Keyframe& Get(std::int64_t id) const { return *keyframes_.at(id); }

@@ -6,12 +6,8 @@
 
 namespace parallax {
 
-MappingWorker::MappingWorker(Process process, FollowUp follow_up, std::size_t max_pending,
-                             int threads)
-    : process_(std::move(process)),
-      follow_up_(std::move(follow_up)),
-      max_pending_(max_pending),
-      arena_(threads) {
+MappingWorker::MappingWorker(Process process, std::size_t max_pending, int threads)
+    : process_(std::move(process)), max_pending_(max_pending), arena_(threads) {
   CheckArgument(max_pending_ >= 1, "MappingWorker: max_pending must be >= 1");
   thread_ = std::thread([this] { Loop(); });
 }
@@ -34,10 +30,17 @@ void MappingWorker::Offer(MappingJob job, bool wait_for_room) {
     }
     RethrowFailure();
     CheckState(!stopping_, "MappingWorker::Offer: stopped");
-    if (refinements() >= max_pending_) {
+    if (job.keep) {
+      // The new keyframe is made next: refinements of the old one are worth less than the
+      // time the tracker may have to wait for it.
+      const auto waiting =
+          std::remove_if(queue_.begin(), queue_.end(), [](const Entry& e) { return Skippable(e); });
+      skipped_ += std::distance(waiting, queue_.end());
+      queue_.erase(waiting, queue_.end());
+    } else if (refinements() >= max_pending_) {
       // The newest frame refines better than an older one mapping has not reached.
       queue_.erase(
-          std::find_if(queue_.begin(), queue_.end(), [](const Entry& e) { return !e.done; }));
+          std::find_if(queue_.begin(), queue_.end(), [](const Entry& e) { return Skippable(e); }));
       ++skipped_;
     }
     queue_.push_back({std::move(job), nullptr});
@@ -56,6 +59,12 @@ FrameResult MappingWorker::Run(MappingJob job) {
   }
   wake_.notify_one();
   return result.get();
+}
+
+void MappingWorker::WaitFor(std::int64_t frame_id) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  idle_.wait(lock, [&] { return done_through_ >= frame_id || stopping_ || failure_; });
+  RethrowFailure();
 }
 
 void MappingWorker::Drain() {
@@ -94,7 +103,6 @@ void MappingWorker::Loop() {
     }
     const bool waited = entry.done != nullptr;
     std::exception_ptr error;
-    std::exception_ptr follow_up_error;
     std::optional<FrameResult> result;
     arena_.execute([&] {
       try {
@@ -107,19 +115,10 @@ void MappingWorker::Loop() {
       error ? entry.done->set_exception(error) : entry.done->set_value(std::move(*result));
       entry.done.reset();
     }
-    if (!error && follow_up_) {
-      arena_.execute([&] {
-        try {
-          follow_up_();
-        } catch (...) {
-          follow_up_error = std::current_exception();
-        }
-      });
-    }
     {
       const std::lock_guard<std::mutex> lock(mutex_);
       if (error && !waited) failure_ = error;
-      if (follow_up_error) failure_ = follow_up_error;
+      done_through_ = std::max(done_through_, entry.job.frame ? entry.job.frame->Id() : -1);
       busy_ = false;
     }
     idle_.notify_all();

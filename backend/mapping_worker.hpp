@@ -1,6 +1,6 @@
 #pragma once
 // The mapping thread of the real-time mode (docs/realtime.md): frames tracked live on the
-// caller's thread come here to refine depth, make keyframes and run the backend. A bounded
+// caller's thread come here to refine depth and make keyframes. A bounded
 // queue with condition variables; when mapping falls behind, the oldest waiting refinement
 // is skipped for the newest. Jobs the caller waits for are never skipped.
 
@@ -48,12 +48,10 @@ struct MappingJob {
 class MappingWorker {
  public:
   using Process = std::function<FrameResult(const MappingJob&)>;
-  using FollowUp = std::function<void()>;
 
-  /// `process` maps a job; `follow_up` runs after each job's result was handed back (work
-  /// the caller need not wait for). `max_pending`: refinement jobs that may wait (>= 1);
-  /// `threads`: the TBB concurrency of the thread's arena. The thread starts here.
-  MappingWorker(Process process, FollowUp follow_up, std::size_t max_pending, int threads);
+  /// `process` maps a job. `max_pending`: refinement jobs that may wait (>= 1); `threads`:
+  /// the TBB concurrency of the thread's arena. The thread starts here.
+  MappingWorker(Process process, std::size_t max_pending, int threads);
   /// Stop().
   ~MappingWorker();
   MappingWorker(const MappingWorker&) = delete;
@@ -66,6 +64,10 @@ class MappingWorker {
   void Offer(MappingJob job, bool wait_for_room = false);
   /// Queues a job behind the waiting ones and returns its result (rethrowing its exception).
   FrameResult Run(MappingJob job);
+  /// Returns once the job of frame `frame_id` (or a later frame's) is done, or the worker
+  /// stopped; rethrows as Offer does. Precondition: that frame's job was queued and is
+  /// never skipped (`keep`).
+  void WaitFor(std::int64_t frame_id);
   /// Returns once every queued job is done (rethrows as Offer does).
   void Drain();
   /// Drops the waiting jobs, lets the running one finish and joins the thread. Idempotent.
@@ -83,7 +85,6 @@ class MappingWorker {
   void RethrowFailure();  // precondition: mutex_ held
 
   Process process_;
-  FollowUp follow_up_;
   std::size_t max_pending_;
   tbb::task_arena arena_;
   mutable std::mutex mutex_;
@@ -94,7 +95,8 @@ class MappingWorker {
   bool stopping_ = false;
   std::exception_ptr failure_;
   std::int64_t skipped_ = 0;
-  std::thread thread_;  ///< last: started when everything above exists
+  std::int64_t done_through_ = -1;  ///< frame id of the newest finished job
+  std::thread thread_;              ///< last: started when everything above exists
 };
 
 }  // namespace parallax

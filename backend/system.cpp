@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "backend/backend_worker.hpp"
 #include "backend/live_tracker.hpp"
 #include "backend/mapping_worker.hpp"
 #include "core/check.hpp"
@@ -108,57 +109,83 @@ void System::FinishCurrentKeyframe(FrameResult* result) {
   }
   FinishedKeyframe finished{keyframe->id, is_new ? current_.parent : std::nullopt,
                             current_.S_parent_kf};
-  // Real-time mode: the caller may be waiting for the next keyframe; the backend's work on
-  // this one runs after it is released (RunDeferredBackend).
-  if (live_) {
-    deferred_backend_.push_back(finished);
+  // Real-time mode: the backend thread takes it (RunBackendBatch).
+  if (backend_worker_) {
+    backend_pending_.push_back(finished);
+    backend_worker_->Notify();
     return;
   }
   RunBackend(finished, result);
 }
 
 void System::RunBackend(const FinishedKeyframe& finished, FrameResult* result) {
+  RunBackendOn(&graph_, finished, result_frame_id_, &backend_stats_, &result->events);
+  chain_information_ = backend_.FallbackInformation();
+  FollowMerges(result->events);
+}
+
+void System::RunBackendOn(KeyframeGraph* graph, const FinishedKeyframe& finished,
+                          std::int64_t frame_id, BackendStats* stats,
+                          std::vector<SystemEvent>* events) {
   const auto start = Clock::now();
   const BackendReport report =
-      backend_.KeyframeFinished(&graph_, finished.id, finished.parent, finished.S_parent_kf);
-  backend_stats_.alignments += report.alignments;
-  backend_stats_.edges_rejected += report.edges_rejected;
+      backend_.KeyframeFinished(graph, finished.id, finished.parent, finished.S_parent_kf);
+  stats->alignments += report.alignments;
+  stats->edges_rejected += report.edges_rejected;
   if (report.optimisation) {
-    CountOptimisation(*report.optimisation);
-    backend_stats_.optimisation_ms.push_back(MillisecondsSince(start));
-    result->events.push_back({SystemEvent::Kind::kGraphOptimised, result_frame_id_, finished.id});
+    CountOptimisation(*report.optimisation, stats);
+    stats->optimisation_ms.push_back(MillisecondsSince(start));
+    events->push_back({SystemEvent::Kind::kGraphOptimised, frame_id, finished.id});
   }
-  RecognisePlace(finished.id, result);
+  RecognisePlace(graph, finished.id, frame_id, stats, events);
 }
 
-void System::CountOptimisation(const PoseGraphSummary& summary) {
-  ++backend_stats_.optimisations;
-  backend_stats_.iterations += summary.iterations;
+void System::CountOptimisation(const PoseGraphSummary& summary, BackendStats* stats) {
+  ++stats->optimisations;
+  stats->iterations += summary.iterations;
 }
 
-void System::RecognisePlace(std::int64_t id, FrameResult* result) {
+void System::RecognisePlace(KeyframeGraph* graph, std::int64_t id, std::int64_t frame_id,
+                            BackendStats* stats, std::vector<SystemEvent>* events) {
   if (!options_.loop_closure.enabled && !options_.relocalization.enabled) return;
-  if (place_.Contains(id)) return;  // refined again: its image did not change
+  {
+    const std::shared_lock<std::shared_mutex> place(place_mutex_);
+    if (place_.Contains(id)) return;  // refined again: its image did not change
+  }
   const auto start = Clock::now();
-  place_.Add(id, place_.Describe(graph_.Get(id).image));
-  const LoopReport loop = loop_closer_.KeyframeFinished(&graph_, &backend_, id);
-  backend_stats_.loop_candidates += loop.candidates;
-  backend_stats_.loop_checks += loop.consistent;
-  backend_stats_.loops_rejected += loop.rejected;
-  if (loop.optimisation) CountOptimisation(*loop.optimisation);
-  backend_stats_.loop_ms.push_back(MillisecondsSince(start));
+  auto entry = place_.Describe(graph->Get(id).image);
+  {
+    const std::unique_lock<std::shared_mutex> place(place_mutex_);
+    place_.Add(id, std::move(entry));
+  }
+  LoopReport loop;
+  {
+    const std::shared_lock<std::shared_mutex> place(place_mutex_);
+    loop = loop_closer_.KeyframeFinished(graph, &backend_, id);
+  }
+  stats->loop_candidates += loop.candidates;
+  stats->loop_checks += loop.consistent;
+  stats->loops_rejected += loop.rejected;
+  if (loop.optimisation) CountOptimisation(*loop.optimisation, stats);
+  stats->loop_ms.push_back(MillisecondsSince(start));
   if (loop.merged_map) {
-    ++backend_stats_.merges;
-    SystemEvent merged{SystemEvent::Kind::kMapsMerged, result_frame_id_, id, *loop.loop_keyframe};
+    ++stats->merges;
+    SystemEvent merged{SystemEvent::Kind::kMapsMerged, frame_id, id, *loop.loop_keyframe};
     merged.map_id = *loop.merged_map;
-    result->events.push_back(merged);
-    if (current_map_ == *loop.merged_map) current_map_ = graph_.MapOf(id);
+    events->push_back(merged);
   }
   if (loop.loop_keyframe) {
-    ++backend_stats_.loops_closed;
-    result->events.push_back(
-        {SystemEvent::Kind::kLoopClosed, result_frame_id_, id, *loop.loop_keyframe});
-    result->events.push_back({SystemEvent::Kind::kGraphOptimised, result_frame_id_, id});
+    ++stats->loops_closed;
+    events->push_back({SystemEvent::Kind::kLoopClosed, frame_id, id, *loop.loop_keyframe});
+    events->push_back({SystemEvent::Kind::kGraphOptimised, frame_id, id});
+  }
+}
+
+void System::FollowMerges(const std::vector<SystemEvent>& events) {
+  for (const SystemEvent& e : events) {
+    if (e.kind == SystemEvent::Kind::kMapsMerged && current_map_ == e.map_id) {
+      current_map_ = graph_.MapOf(e.keyframe_id);
+    }
   }
 }
 
@@ -200,8 +227,10 @@ void System::Record(std::int64_t frame_id, const FrameResult& result) {
 void System::ClearMap() {
   // A failed start of a later map keeps the earlier maps (no keyframe of the failed start
   // was finished: initialisation completes before any keyframe is left).
+  // No backend work can be running then (real-time mode): it only follows finished keyframes.
   if (current_map_ == 0) {
     graph_.Clear();
+    const std::unique_lock<std::shared_mutex> place(place_mutex_);
     place_.Clear();
     loop_closer_.Clear();
   }
@@ -369,10 +398,14 @@ std::optional<TrackingResult> System::TrackRecentKeyframes(const Frame& frame,
 
 std::optional<std::pair<std::shared_ptr<const Keyframe>, TrackingResult>> System::Relocalise(
     const Frame& frame, const ImageU8& image) {
-  if (!options_.relocalization.enabled || place_.Size() == 0) return std::nullopt;
+  std::vector<RelocalizationGuess> guesses;
+  {
+    const std::shared_lock<std::shared_mutex> place(place_mutex_);
+    if (!options_.relocalization.enabled || place_.Size() == 0) return std::nullopt;
+    guesses = relocalizer_.Propose(graph_, place_, *place_.Describe(image));
+  }
   ++backend_stats_.relocalisation_attempts;
-  const auto entry = place_.Describe(image);
-  for (const RelocalizationGuess& guess : relocalizer_.Propose(graph_, place_, *entry)) {
+  for (const RelocalizationGuess& guess : guesses) {
     const auto keyframe = Materialize(graph_.GetPtr(guess.keyframe_id), camera_, options_.pyramid,
                                       options_.reference);
     TrackingResult r =
@@ -495,6 +528,24 @@ std::vector<FramePose> System::Trajectory() const {
   return poses;
 }
 
+void BackendStats::Add(const BackendStats& other) {
+  optimisations += other.optimisations;
+  iterations += other.iterations;
+  alignments += other.alignments;
+  edges_rejected += other.edges_rejected;
+  optimisation_ms.insert(optimisation_ms.end(), other.optimisation_ms.begin(),
+                         other.optimisation_ms.end());
+  loop_candidates += other.loop_candidates;
+  loop_checks += other.loop_checks;
+  loops_rejected += other.loops_rejected;
+  loops_closed += other.loops_closed;
+  loop_ms.insert(loop_ms.end(), other.loop_ms.begin(), other.loop_ms.end());
+  relocalisation_attempts += other.relocalisation_attempts;
+  relocalisations += other.relocalisations;
+  maps_started += other.maps_started;
+  merges += other.merges;
+}
+
 BackendStats System::Backend() const {
   const std::lock_guard<std::mutex> lock(engine_mutex_);
   return backend_stats_;
@@ -506,7 +557,7 @@ int System::CurrentMap() const {
 }
 
 std::size_t System::PlaceRecognitionBytes() const {
-  const std::lock_guard<std::mutex> lock(engine_mutex_);
+  const std::shared_lock<std::shared_mutex> place(place_mutex_);
   return place_.Bytes();
 }
 

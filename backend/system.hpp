@@ -8,6 +8,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <shared_mutex>
 #include <span>
 #include <string>
 #include <vector>
@@ -64,6 +65,10 @@ struct RealtimeOptions {
   /// The snapshot carries the world poses of this many newest finished keyframes, so that
   /// the live state can follow keyframe changes it did not see (docs/realtime.md).
   int snapshot_keyframe_poses = 8;
+  /// TBB concurrency of the backend thread, and its niceness (0-19): with two cores it
+  /// shares them with tracking and mapping, which go first when it is positive.
+  int backend_threads = 1;
+  int backend_nice = 10;
 
   void Check() const;
 };
@@ -192,8 +197,10 @@ struct FramePose {
 /// Real-time mode figures (zero in the deterministic mode).
 struct RealtimeStats {
   std::int64_t frames_tracked_live = 0;  ///< answered by the caller's tracker alone
-  std::int64_t frames_mapped_waiting =
-      0;  ///< the caller waited for mapping (start, lost, keyframe)
+  /// The caller waited for mapping to track the frame itself (start, lost, no keyframe).
+  std::int64_t frames_mapped_waiting = 0;
+  /// The caller waited for a keyframe it had asked for, then tracked the frame itself.
+  std::int64_t frames_waiting_for_keyframe = 0;
   std::int64_t frames_skipped_by_mapping = 0;  ///< tracked, never used to refine depth
 };
 
@@ -213,6 +220,9 @@ struct BackendStats {
   int relocalisations = 0;
   int maps_started = 0;  ///< new maps after long loss (the first map not counted)
   int merges = 0;
+
+  /// Adds `other`'s counts and appends its timings.
+  void Add(const BackendStats& other);
 };
 
 /// Per-frame outcome.
@@ -244,7 +254,9 @@ struct KeyframeRecord {
 
 struct MappingJob;
 struct LiveTracking;
+struct LiveSnapshot;
 class MappingWorker;
+class BackendWorker;
 struct LiveTracker;
 
 /// Runs tracking and mapping for each frame. Deterministic mode: every stage in order on the
@@ -327,6 +339,19 @@ class System {
   // Real-time mode (system_realtime.cpp).
   /// Tracks on the caller's thread against the published keyframe; hands the frame on.
   FrameResult ProcessLive(std::int64_t id, double timestamp, const ImageU8& image);
+  /// A frame tracked live, with the keyframe rule's verdict on it.
+  struct LiveStep {
+    TrackingResult tracked;
+    double tracking_ms = 0.0;
+    bool keep = false;     ///< it asks mapping for a new keyframe
+    bool overdue = false;  ///< past the rule by keyframe_wait_factor: the keyframe must exist
+  };
+  LiveStep TrackLive(const Frame& frame, const LiveSnapshot& snapshot);
+  /// Waits for mapping to finish the frame that asked for a keyframe; returns the wait (ms).
+  double WaitForRequestedKeyframe();
+  /// Records the live pose and hands the frame to mapping.
+  FrameResult AnswerLive(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
+                         const LiveSnapshot& snapshot, const LiveStep& step);
   /// The mapping thread's work on one frame (takes the engine lock).
   FrameResult MapJob(const MappingJob& job);
   /// After a mapped frame: what the live tracker reads (engine lock held).
@@ -349,15 +374,26 @@ class System {
     std::optional<std::int64_t> parent;  ///< set when it is new (odometry edge to add)
     Sim3d S_parent_kf;
   };
-  /// Constraint search, optimisation and place recognition for a finished keyframe.
+  /// Constraint search, optimisation and place recognition for a finished keyframe, on the
+  /// graph (deterministic mode).
   void RunBackend(const FinishedKeyframe& finished, FrameResult* result);
-  /// Real-time mode, after a mapped frame's result is handed back: the deferred backend work.
-  void RunDeferredBackend();
-  /// Adds an optimisation to the backend statistics.
-  void CountOptimisation(const PoseGraphSummary& summary);
+  /// The same on `graph` (the graph or the backend thread's copy of it), counting into
+  /// `stats`; events are reported as of frame `frame_id`.
+  void RunBackendOn(KeyframeGraph* graph, const FinishedKeyframe& finished, std::int64_t frame_id,
+                    BackendStats* stats, std::vector<SystemEvent>* events);
+  /// Real-time mode, the backend thread: every keyframe waiting, on a copy of the graph
+  /// taken and given back under the engine lock (KeyframeGraph::AdoptOptimised).
+  void RunBackendBatch();
+  /// Odometry edges (tracking's relative pose, chain_information_) for `keyframes` that
+  /// have none to their parent yet.
+  void AddChainEdges(KeyframeGraph* graph, const std::vector<FinishedKeyframe>& keyframes) const;
+  /// A merge of the map new keyframes join makes them join the merged map.
+  void FollowMerges(const std::vector<SystemEvent>& events);
+  static void CountOptimisation(const PoseGraphSummary& summary, BackendStats* stats);
   /// Place recognition for the finished keyframe `id` (its entry in the database); a
   /// verified loop becomes an edge.
-  void RecognisePlace(std::int64_t id, FrameResult* result);
+  void RecognisePlace(KeyframeGraph* graph, std::int64_t id, std::int64_t frame_id,
+                      BackendStats* stats, std::vector<SystemEvent>* events);
   /// For a frame lost against the current and recent keyframes: database candidates, PnP on
   /// their depth, direct confirmation; the keyframe found becomes current.
   /// Returns the keyframe found (rebuilt if it was compacted) and the frame tracked on it.
@@ -500,12 +536,20 @@ class System {
   /// (the start completing, a restart, a new map): live tracking of an older generation is
   /// not used for depth updates (real-time mode).
   std::uint64_t map_generation_ = 0;
-  /// Real-time mode: finished keyframes waiting for the backend (mapping thread only).
-  std::vector<FinishedKeyframe> deferred_backend_;
+  /// Real-time mode: finished keyframes waiting for the backend thread, and those it works
+  /// on (engine lock).
+  std::vector<FinishedKeyframe> backend_pending_;
+  std::vector<FinishedKeyframe> backend_running_;
+  /// Information of an odometry edge the backend did not align (GraphBackend's fallback).
+  Matrix7d chain_information_ = Matrix7d::Identity();
+  /// Guards place_ (the backend thread adds to it while mapping relocalises on it); taken
+  /// after engine_mutex_ when both are.
+  mutable std::shared_mutex place_mutex_;
   /// Events of frames mapped behind the caller, for its next result.
   std::vector<SystemEvent> pending_events_;
-  std::unique_ptr<LiveTracker> live_;      ///< real-time mode only
-  std::unique_ptr<MappingWorker> worker_;  ///< real-time mode only; destroyed first
+  std::unique_ptr<LiveTracker> live_;              ///< real-time mode only
+  std::unique_ptr<BackendWorker> backend_worker_;  ///< real-time mode only
+  std::unique_ptr<MappingWorker> worker_;          ///< real-time mode only; destroyed first
 };
 
 }  // namespace parallax

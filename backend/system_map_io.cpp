@@ -42,15 +42,19 @@ std::vector<std::uint8_t> System::EncodeMapBytesLocked() const {
   // A copy of the graph (keyframes are shared, immutable) with the unfinished current
   // keyframe added as it stands, so that saving changes nothing in the running system.
   KeyframeGraph graph = graph_;
+  // Real-time mode: keyframes the backend has not linked yet get their tracking chain.
+  AddChainEdges(&graph, backend_running_);
+  AddChainEdges(&graph, backend_pending_);
   if (mapper_.HasMap() && !graph.Contains(current_.id)) {
     graph.Upsert(mapper_.Freeze(), CurrentKeyframePose(), current_map_);
     if (current_.parent && graph.Contains(*current_.parent)) {
       graph.AddEdge(PoseGraphEdge{*current_.parent, current_.id, current_.S_parent_kf,
-                                  backend_.FallbackInformation(), EdgeKind::kOdometry});
+                                  chain_information_, EdgeKind::kOdometry});
     }
   }
   // Keyframes described only here (place recognition off, or the current one) keep their
   // entries alive until the map is encoded.
+  const std::shared_lock<std::shared_mutex> place(place_mutex_);
   std::vector<std::shared_ptr<const PlaceEntry>> described;
   std::map<std::int64_t, const OrbFeatures*> features;
   for (const std::int64_t id : graph.Ids()) {
@@ -91,6 +95,7 @@ void System::LoadMapBytes(std::span<const std::uint8_t> bytes, const std::string
   }
   // Everything is decoded and checked: from here on nothing throws but allocation.
   graph_ = std::move(contents.graph);
+  const std::unique_lock<std::shared_mutex> place(place_mutex_);
   place_.Clear();
   loop_closer_.Clear();
   for (auto& [id, features] : contents.features)

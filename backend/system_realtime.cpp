@@ -4,6 +4,7 @@
 #include <chrono>
 #include <opencv2/core/utility.hpp>
 
+#include "backend/backend_worker.hpp"
 #include "backend/live_tracker.hpp"
 #include "backend/mapping_worker.hpp"
 #include "backend/system.hpp"
@@ -26,27 +27,51 @@ void RealtimeOptions::Check() const {
               "must be >= 1");
   CheckOption(snapshot_keyframe_poses >= 0, "RealtimeOptions", "snapshot_keyframe_poses",
               "must be >= 0");
+  CheckOption(backend_threads >= 1, "RealtimeOptions", "backend_threads", "must be >= 1");
+  CheckOption(backend_nice >= 0 && backend_nice <= 19, "RealtimeOptions", "backend_nice",
+              "must be in [0, 19]");
 }
 
 void System::StartRealtime() {
   cv::setNumThreads(options_.realtime.opencv_threads);
   live_ = std::make_unique<LiveTracker>(options_.tracker, options_.realtime.tracking_threads);
+  chain_information_ = backend_.FallbackInformation();
+  backend_worker_ = std::make_unique<BackendWorker>([this] { RunBackendBatch(); },
+                                                    options_.realtime.backend_threads,
+                                                    options_.realtime.backend_nice);
   worker_ = std::make_unique<MappingWorker>(
-      [this](const MappingJob& job) { return MapJob(job); }, [this] { RunDeferredBackend(); },
+      [this](const MappingJob& job) { return MapJob(job); },
       static_cast<std::size_t>(options_.realtime.max_pending_frames),
       options_.realtime.mapping_threads);
 }
 
-System::~System() {
-  if (worker_) worker_->Stop();
-}
+System::~System() { StopMapping(); }
 
 void System::FinishMapping() {
-  if (worker_) worker_->Drain();
+  if (!worker_) return;
+  worker_->Drain();  // mapping first: it may finish keyframes for the backend
+  backend_worker_->Drain();
 }
 
 void System::StopMapping() {
-  if (worker_) worker_->Stop();
+  if (!worker_) return;
+  worker_->Stop();
+  backend_worker_->Stop();
+  // Keyframes the backend never reached keep the chain tracking made (no keyframe made is
+  // lost; they are only not optimised).
+  const std::lock_guard<std::mutex> lock(engine_mutex_);
+  AddChainEdges(&graph_, std::exchange(backend_pending_, {}));
+}
+
+void System::AddChainEdges(KeyframeGraph* graph,
+                           const std::vector<FinishedKeyframe>& keyframes) const {
+  for (const FinishedKeyframe& k : keyframes) {
+    if (k.parent && graph->Contains(*k.parent) && graph->Contains(k.id) &&
+        !graph->HasEdge(*k.parent, k.id)) {
+      graph->AddEdge(
+          PoseGraphEdge{*k.parent, k.id, k.S_parent_kf, chain_information_, EdgeKind::kOdometry});
+    }
+  }
 }
 
 RealtimeStats System::Realtime() const {
@@ -54,6 +79,7 @@ RealtimeStats System::Realtime() const {
   if (!live_) return stats;
   stats.frames_tracked_live = live_->tracked_live;
   stats.frames_mapped_waiting = live_->mapped_waiting;
+  stats.frames_waiting_for_keyframe = live_->waited_for_keyframe;
   stats.frames_skipped_by_mapping = worker_->Skipped();
   return stats;
 }
@@ -79,52 +105,94 @@ FrameResult System::ProcessLive(std::int64_t id, double timestamp, const ImageU8
   live_->arena.execute([&] {
     frame = std::make_shared<const Frame>(id, timestamp, camera_, image, options_.pyramid);
   });
-  const LiveSnapshot snapshot = live_->Latest();
+  LiveSnapshot snapshot = live_->Latest();
   if (!snapshot.usable) return WaitForMapping(frame, image, std::nullopt, LiveTracking{});
   live_->Follow(snapshot);
-  const auto start = Clock::now();
-  TrackingResult tracked;
-  live_->arena.execute([&] { tracked = live_->tracker.Track(*snapshot.reference, *frame); });
-  const double tracking_ms = MillisecondsSince(start);
-  // Lost: the mapping thread tracks it again from the live tracker's motion, then tries the
-  // recent keyframes and relocalisation with the whole map.
-  if (tracked.status == TrackingStatus::kLost) {
-    return WaitForMapping(
-        frame, image, std::nullopt,
-        LiveTracking{snapshot.keyframe_id, tracked, live_->tracker.State(), snapshot.generation});
+  const MotionState before = live_->tracker.State();
+  LiveStep step = TrackLive(*frame, snapshot);
+  if (step.overdue && live_->keyframe_request_frame >= 0) {
+    // The keyframe this one needs was asked for by an earlier frame: wait until mapping
+    // has made it (only that job, not the refinements or the backend behind it), then
+    // track the frame again against it.
+    const double waited_ms = WaitForRequestedKeyframe();
+    const LiveSnapshot next = live_->Latest();
+    if (next.usable && next.keyframe_id != snapshot.keyframe_id) {
+      live_->tracker.SetState(before);
+      snapshot = next;
+      live_->Follow(snapshot);
+      const double first_ms = step.tracking_ms;
+      step = TrackLive(*frame, snapshot);
+      step.tracking_ms += first_ms + waited_ms;
+    }
   }
-  LiveTracking live{snapshot.keyframe_id, tracked, live_->tracker.State(), snapshot.generation};
+  if (step.tracked.status == TrackingStatus::kLost) {
+    // Lost: the mapping thread tracks it again from the live tracker's motion, then tries
+    // the recent keyframes and relocalisation with the whole map.
+    return WaitForMapping(frame, image, std::nullopt,
+                          LiveTracking{snapshot.keyframe_id, step.tracked, live_->tracker.State(),
+                                       snapshot.generation});
+  }
+  if (step.overdue) {
+    // Still past the rule with no new keyframe: this frame is mapped (and tracked again)
+    // after the waiting jobs.
+    FrameResult result = WaitForMapping(frame, image, std::nullopt, LiveTracking{});
+    result.tracking_ms += step.tracking_ms;
+    return result;
+  }
+  return AnswerLive(frame, image, snapshot, step);
+}
+
+System::LiveStep System::TrackLive(const Frame& frame, const LiveSnapshot& snapshot) {
+  LiveStep step;
+  const auto start = Clock::now();
+  live_->arena.execute([&] { step.tracked = live_->tracker.Track(*snapshot.reference, frame); });
+  step.tracking_ms = MillisecondsSince(start);
+  if (step.tracked.status == TrackingStatus::kLost) return step;
   // The keyframe rule of MapFrame: a frame that wants a new keyframe is never skipped by
   // mapping (once per keyframe); tracking goes on against the current one meanwhile, which
   // still tracks (the rule fires well before the view is lost), and follows the new one
   // when it is published.
-  const double relative_distance = tracked.T_kf_frame.Translation().norm() * snapshot.mean_idepth;
-  const bool view_degrades = tracked.stats.usage < options_.min_keyframe_usage ||
-                             tracked.stats.good_ratio < options_.min_keyframe_good_ratio;
-  const bool wants_keyframe = snapshot.initialised &&
-                              live.motion.frames_in_keyframe >= options_.min_frames_per_keyframe &&
-                              (view_degrades || relative_distance > options_.keyframe_distance);
-  const bool keep = wants_keyframe && live_->keyframe_requested_in != snapshot.keyframe_id;
-  if (keep) live_->keyframe_requested_in = snapshot.keyframe_id;
+  const TrackingResult& t = step.tracked;
+  const double relative_distance = t.T_kf_frame.Translation().norm() * snapshot.mean_idepth;
+  const bool view_degrades = t.stats.usage < options_.min_keyframe_usage ||
+                             t.stats.good_ratio < options_.min_keyframe_good_ratio;
+  const bool wants_keyframe =
+      snapshot.initialised &&
+      live_->tracker.State().frames_in_keyframe >= options_.min_frames_per_keyframe &&
+      (view_degrades || relative_distance > options_.keyframe_distance);
+  step.keep = wants_keyframe && live_->keyframe_requested_in != snapshot.keyframe_id;
   const double f = options_.realtime.keyframe_wait_factor;
-  if (wants_keyframe && !keep &&
-      (relative_distance > f * options_.keyframe_distance ||
-       tracked.stats.usage * f < options_.min_keyframe_usage ||
-       tracked.stats.good_ratio * f < options_.min_keyframe_good_ratio)) {
-    // The requested keyframe is overdue: this frame is mapped (and tracked again) after it.
-    FrameResult result = WaitForMapping(frame, image, std::nullopt, LiveTracking{});
-    result.tracking_ms += tracking_ms;
-    return result;
+  step.overdue = wants_keyframe && !step.keep &&
+                 (relative_distance > f * options_.keyframe_distance ||
+                  t.stats.usage * f < options_.min_keyframe_usage ||
+                  t.stats.good_ratio * f < options_.min_keyframe_good_ratio);
+  return step;
+}
+
+double System::WaitForRequestedKeyframe() {
+  const auto start = Clock::now();
+  worker_->WaitFor(live_->keyframe_request_frame);
+  ++live_->waited_for_keyframe;
+  return MillisecondsSince(start);
+}
+
+FrameResult System::AnswerLive(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
+                               const LiveSnapshot& snapshot, const LiveStep& step) {
+  if (step.keep) {
+    live_->keyframe_requested_in = snapshot.keyframe_id;
+    live_->keyframe_request_frame = frame->Id();
   }
   FrameResult result;
-  result.status = tracked.status;
-  result.stats = tracked.stats;
-  result.tracking_ms = tracking_ms;
+  result.status = step.tracked.status;
+  result.stats = step.tracked.stats;
+  result.tracking_ms = step.tracking_ms;
   result.initialising = !snapshot.initialised;
-  result.anchor = AnchoredPose{snapshot.keyframe_id, tracked.T_kf_frame};
-  result.T_w_c = (snapshot.S_w_kf * Sim3d(tracked.T_kf_frame)).RigidPart();
+  result.anchor = AnchoredPose{snapshot.keyframe_id, step.tracked.T_kf_frame};
+  result.T_w_c = (snapshot.S_w_kf * Sim3d(step.tracked.T_kf_frame)).RigidPart();
   Record(frame->Id(), result);
-  worker_->Offer(MappingJob{frame, image, std::move(live), false, keep, LiveTracking{}},
+  LiveTracking live{snapshot.keyframe_id, step.tracked, live_->tracker.State(),
+                    snapshot.generation};
+  worker_->Offer(MappingJob{frame, image, std::move(live), false, step.keep, LiveTracking{}},
                  !snapshot.initialised);
   ++live_->tracked_live;
   TakePendingEvents(&result);
@@ -170,16 +238,33 @@ FrameResult System::MapJob(const MappingJob& job) {
   return result;
 }
 
-void System::RunDeferredBackend() {
-  const std::lock_guard<std::mutex> lock(engine_mutex_);
-  if (deferred_backend_.empty()) return;
-  FrameResult result;
-  for (const FinishedKeyframe& finished : std::exchange(deferred_backend_, {})) {
-    RunBackend(finished, &result);
+void System::RunBackendBatch() {
+  // Inputs under the engine lock: the keyframes waiting and a copy of the graph (keyframes
+  // are shared and immutable: the copy is poses, edges and pointers).
+  std::unique_lock<std::mutex> engine(engine_mutex_);
+  if (backend_pending_.empty()) return;
+  backend_running_ = std::exchange(backend_pending_, {});
+  KeyframeGraph work = graph_;
+  const std::size_t edges_before = work.Poses().Edges().size();
+  const std::int64_t frame_id = result_frame_id_;
+  engine.unlock();
+  // The work, while tracking and mapping go on.
+  BackendStats stats;
+  std::vector<SystemEvent> events;
+  for (const FinishedKeyframe& finished : backend_running_) {
+    RunBackendOn(&work, finished, frame_id, &stats, &events);
   }
+  const Matrix7d chain_information = backend_.FallbackInformation();
+  // The result, under the lock again: keyframes made meanwhile move with their map.
+  engine.lock();
+  graph_.AdoptOptimised(work, edges_before);
+  backend_running_.clear();
+  backend_stats_.Add(stats);
+  chain_information_ = chain_information;
+  FollowMerges(events);
   PublishLive();  // keyframe poses moved
-  const std::lock_guard<std::mutex> events(poses_mutex_);
-  pending_events_.insert(pending_events_.end(), result.events.begin(), result.events.end());
+  const std::lock_guard<std::mutex> pending(poses_mutex_);
+  pending_events_.insert(pending_events_.end(), events.begin(), events.end());
 }
 
 void System::PublishLive() {

@@ -132,7 +132,9 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"mapping_threads", Set(&o->realtime.mapping_threads)},
         {"opencv_threads", Set(&o->realtime.opencv_threads)},
         {"keyframe_wait_factor", Set(&o->realtime.keyframe_wait_factor)},
-        {"snapshot_keyframe_poses", Set(&o->realtime.snapshot_keyframe_poses)}}},
+        {"snapshot_keyframe_poses", Set(&o->realtime.snapshot_keyframe_poses)},
+        {"backend_threads", Set(&o->realtime.backend_threads)},
+        {"backend_nice", Set(&o->realtime.backend_nice)}}},
   };
 }
 

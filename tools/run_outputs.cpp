@@ -102,6 +102,7 @@ void WriteStats(const std::string& path, const RunSummary& s) {
                        {"frames_dropped", s.frames_dropped},
                        {"frames_tracked_live", s.mapping.frames_tracked_live},
                        {"frames_waiting_for_mapping", s.mapping.frames_mapped_waiting},
+                       {"frames_waiting_for_keyframe", s.mapping.frames_waiting_for_keyframe},
                        {"frames_skipped_by_mapping", s.mapping.frames_skipped_by_mapping}};
   }
   std::ofstream out(path);

@@ -86,6 +86,57 @@ TEST(KeyframeGraph, PointsFollowACorrectionOfTheirKeyframe) {
   }
 }
 
+/// True when two similarities agree to 1e-9 (rotation, translation, scale).
+bool SameSim3(const Sim3d& a, const Sim3d& b) {
+  const Sim3d d = a.Inverse() * b;
+  return d.Translation().norm() < 1e-9 && d.Rotation().Log().norm() < 1e-9 &&
+         std::abs(d.Scale() - 1.0) < 1e-9;
+}
+
+// The real-time backend optimises a copy while mapping goes on: its result is taken back
+// with the keyframes made meanwhile moved along, and a merge made in the copy carried over.
+TEST(KeyframeGraph, AnOptimisedCopyIsAdoptedAndLaterKeyframesMoveWithTheirMap) {
+  const auto at = [](double x, double s = 1.0) {
+    return Sim3d(s, SO3d::Exp(Eigen::Vector3d(0, 0.1 * x, 0)), Eigen::Vector3d(x, 0, 0));
+  };
+  KeyframeGraph graph;
+  graph.Upsert(SmallKeyframe(0), at(0));
+  graph.Upsert(SmallKeyframe(1), at(1));
+  graph.Upsert(SmallKeyframe(2), at(0.5), 1);  // a second map, its own gauge
+  graph.AddEdge(PoseGraphEdge{0, 1, at(1), Matrix7d::Identity(), EdgeKind::kOdometry});
+  KeyframeGraph copy = graph;  // the backend's
+  const std::size_t edges_before = copy.Poses().Edges().size();
+  // Meanwhile mapping adds a keyframe to each map and replaces keyframe 1's data.
+  graph.Upsert(SmallKeyframe(3), at(2));
+  graph.Upsert(SmallKeyframe(4), at(1.5), 1);
+  auto replaced = SmallKeyframe(1);
+  replaced->timestamp = 7.0;
+  graph.Upsert(replaced, at(9));  // data replaced, pose kept
+  // The backend moves keyframe 1, adds a loop edge and merges map 1 into map 0.
+  const Sim3d moved = Sim3d(1.2, SO3d::Exp(Eigen::Vector3d(0.05, 0, 0)), Eigen::Vector3d(1, 1, 0));
+  copy.Poses().SetPose(1, moved);
+  const Sim3d S_0_1(0.5, SO3d::Exp(Eigen::Vector3d(0, 0, 0.2)), Eigen::Vector3d(0, 2, 0));
+  copy.MergeMaps(1, 0, S_0_1);
+  copy.AddEdge(PoseGraphEdge{1, 2, at(1), Matrix7d::Identity(), EdgeKind::kLoop});
+  graph.AdoptOptimised(copy, edges_before);
+
+  EXPECT_TRUE(SameSim3(graph.Pose(1), moved));
+  EXPECT_EQ(graph.Get(1).timestamp, 7.0);  // the graph's data, the copy's pose
+  // Keyframe 3 keeps its pose relative to keyframe 1, the newest of its map in the copy.
+  EXPECT_TRUE(SameSim3(graph.Pose(3), moved * at(1).Inverse() * at(2)));
+  // Map 1 was merged: keyframe 2 as the copy has it, keyframe 4 moved with it.
+  EXPECT_EQ(graph.MapOf(2), 0);
+  EXPECT_EQ(graph.MapOf(4), 0);
+  EXPECT_EQ(graph.NumMaps(), 1);
+  EXPECT_TRUE(SameSim3(graph.Pose(2), S_0_1 * at(0.5)));
+  EXPECT_TRUE(SameSim3(graph.Pose(4), S_0_1 * at(1.5)));
+  EXPECT_FALSE(graph.Poses().IsFixed(2));
+  EXPECT_FALSE(graph.Poses().IsFixed(4));
+  EXPECT_TRUE(graph.Poses().IsFixed(0));
+  ASSERT_EQ(graph.Poses().Edges().size(), 2u);
+  EXPECT_EQ(graph.Poses().Edges()[1].kind, EdgeKind::kLoop);
+}
+
 TEST_F(KeyframeGraphTest, CompactedKeyframesRebuildTheSameReference) {
   std::optional<PinholeCamera> K;
   const DatasetFrame first = Frames(1, &K).front();

@@ -11,6 +11,7 @@
 #include <future>
 #include <thread>
 
+#include "backend/backend_worker.hpp"
 #include "backend/mapping_worker.hpp"
 #include "backend/system.hpp"
 #include "tests/tracking/render_fixture.hpp"
@@ -49,7 +50,7 @@ struct GatedProcess {
 
 TEST(MappingWorker, WhenBehindTheOldestWaitingRefinementIsSkipped) {
   GatedProcess process;
-  MappingWorker worker(process.Function(), nullptr, 1, 1);
+  MappingWorker worker(process.Function(), 1, 1);
   worker.Offer(Job(0));  // taken by the thread, blocked at the gate (or still queued)
   for (int id = 1; id <= 5; ++id) worker.Offer(Job(id));
   MappingJob kept = Job(6);
@@ -68,7 +69,7 @@ TEST(MappingWorker, WhenBehindTheOldestWaitingRefinementIsSkipped) {
 TEST(MappingWorker, AWaitedJobRunsAfterTheQueuedOnesAndExceptionsReachTheCaller) {
   GatedProcess process;
   process.open.set_value();
-  MappingWorker worker(process.Function(), nullptr, 4, 1);
+  MappingWorker worker(process.Function(), 4, 1);
   worker.Offer(Job(1));
   worker.Run(Job(2));
   EXPECT_EQ(process.seen, (std::vector<std::int64_t>{1, 2}));
@@ -82,7 +83,7 @@ TEST(MappingWorker, AWaitedJobRunsAfterTheQueuedOnesAndExceptionsReachTheCaller)
 
 TEST(MappingWorker, StopDropsWaitingJobsAndRefusesNewOnes) {
   GatedProcess process;
-  MappingWorker worker(process.Function(), nullptr, 8, 1);
+  MappingWorker worker(process.Function(), 8, 1);
   for (int id = 0; id < 5; ++id) worker.Offer(Job(id));
   std::thread opener([&] { process.open.set_value(); });
   worker.Stop();
@@ -90,6 +91,85 @@ TEST(MappingWorker, StopDropsWaitingJobsAndRefusesNewOnes) {
   EXPECT_LE(process.seen.size(), 1u);  // at most the one running when stopped
   EXPECT_THROW(worker.Offer(Job(9)), std::logic_error);
   worker.Stop();  // idempotent
+}
+
+TEST(MappingWorker, AKeyframeRequestGoesBeforeWaitingRefinementsAndCanBeWaitedFor) {
+  GatedProcess process;
+  MappingWorker worker(process.Function(), 4, 1);
+  worker.Offer(Job(0));
+  worker.Offer(Job(1));
+  worker.Offer(Job(2));
+  MappingJob kept = Job(3);
+  kept.keep = true;
+  worker.Offer(std::move(kept));
+  std::atomic<bool> returned{false};
+  std::thread waiter([&] {
+    worker.WaitFor(3);
+    returned = true;
+  });
+  EXPECT_FALSE(returned.load());  // the gate is closed: job 3 cannot be done
+  process.open.set_value();
+  waiter.join();
+  worker.Drain();
+  // 1 and 2 were waiting when the keyframe was asked for: skipped (0 may have been too).
+  EXPECT_EQ(process.seen.back(), 3);
+  EXPECT_EQ(std::count(process.seen.begin(), process.seen.end(), 1), 0);
+  EXPECT_EQ(std::count(process.seen.begin(), process.seen.end(), 2), 0);
+  EXPECT_EQ(static_cast<std::int64_t>(process.seen.size()) + worker.Skipped(), 4);
+}
+
+TEST(MappingWorker, AWaitForEndsWhenTheWorkerStops) {
+  GatedProcess process;
+  MappingWorker worker(process.Function(), 4, 1);
+  MappingJob kept = Job(5);
+  kept.keep = true;
+  worker.Offer(std::move(kept));
+  std::thread waiter([&] { worker.WaitFor(5); });
+  std::thread opener([&] { process.open.set_value(); });
+  worker.Stop();
+  waiter.join();
+  opener.join();
+}
+
+TEST(BackendWorker, RunsOncePerBurstOfRequestsAndAgainForLaterOnes) {
+  std::promise<void> open;
+  std::shared_future<void> gate = open.get_future().share();
+  std::atomic<int> runs{0};
+  BackendWorker worker(
+      [&] {
+        gate.wait();
+        ++runs;
+      },
+      1, 10);
+  worker.Notify();
+  worker.Notify();  // while the first run waits at the gate, or before it started
+  worker.Notify();
+  open.set_value();
+  worker.Drain();
+  const int burst = runs.load();
+  EXPECT_GE(burst, 1);
+  EXPECT_LE(burst, 2);  // requests made during a run wake it once more, not once each
+  worker.Notify();
+  worker.Drain();
+  EXPECT_EQ(runs.load(), burst + 1);
+  EXPECT_EQ(worker.Runs(), burst + 1);
+}
+
+TEST(BackendWorker, ExceptionsReachTheCallerAndStopReportsWaitingWork) {
+  std::atomic<bool> fail{true};
+  BackendWorker worker(
+      [&] {
+        if (fail) throw std::runtime_error("backend failed");
+      },
+      1, 0);
+  worker.Notify();
+  EXPECT_THROW(worker.Drain(), std::runtime_error);
+  fail = false;
+  worker.Notify();  // reported once; the worker goes on
+  worker.Drain();
+  EXPECT_FALSE(worker.Stop());  // nothing was waiting
+  EXPECT_THROW(worker.Notify(), std::logic_error);
+  EXPECT_FALSE(worker.Stop());  // idempotent
 }
 
 const synth::Scene& Room() {
@@ -151,6 +231,13 @@ TEST(Realtime, SystemsStoppedOrDestroyedMidStreamKeepTheirKeyframes) {
     const std::size_t keyframes = system.Keyframes().size();
     system.StopMapping();
     EXPECT_GE(system.Keyframes().size(), keyframes);  // none made is lost
+    // ... and each finished one is linked to the keyframe it grew from, by the backend or,
+    // when it never got to it, by tracking's chain.
+    const KeyframeGraph& graph = system.Graph();
+    const std::vector<std::int64_t> ids = graph.Ids();
+    for (std::size_t k = 1; k < ids.size(); ++k) {
+      EXPECT_TRUE(graph.HasEdge(ids[k - 1], ids[k])) << ids[k - 1] << "-" << ids[k];
+    }
     EXPECT_THROW(system.ProcessFrame(test::RenderTestImage(Room(), OrbitPose(frames)), 99.0),
                  std::logic_error);
   }

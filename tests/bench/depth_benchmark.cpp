@@ -74,6 +74,31 @@ void BM_Regularize(benchmark::State& state) {
 }
 BENCHMARK(BM_Regularize)->Unit(benchmark::kMillisecond);
 
+// Keyframe creation's depth step: the map moved into a frame 5 cm away (projection, two
+// regularisations and hole filling), and hole filling alone.
+void BM_Propagate(benchmark::State& state) {
+  static const Fixture f;
+  const DepthFilter filter;
+  const SE3d T_new_old = f.T_frame_kf;
+  for (auto _ : state) {
+    InverseDepthMap next = filter.Propagate(*f.map, f.frame, T_new_old, 1.0f, 0.0f);
+    benchmark::DoNotOptimize(next.idepth.data());
+  }
+}
+BENCHMARK(BM_Propagate)->Unit(benchmark::kMillisecond);
+
+void BM_FillHoles(benchmark::State& state) {
+  static const Fixture f;
+  const DepthFilter filter;
+  for (auto _ : state) {
+    state.PauseTiming();
+    InverseDepthMap map = *f.map;
+    state.ResumeTiming();
+    benchmark::DoNotOptimize(filter.FillHoles(&map));
+  }
+}
+BENCHMARK(BM_FillHoles)->Unit(benchmark::kMillisecond);
+
 }  // namespace
 }  // namespace parallax
 
