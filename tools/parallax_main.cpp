@@ -34,11 +34,15 @@ int Run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Frame pyramids (several MB) are allocated and freed every frame. glibc raises its mmap
-  // threshold after the first such free, after which they come from the heap and fragment
-  // it, so RSS keeps the peak of the short-lived buffers; a fixed threshold keeps them mapped
-  // and returned when freed (docs/benchmarks.md, "Keyframe graph in the pipeline").
-  mallopt(M_MMAP_THRESHOLD, 1 << 20);
+  // Frame pyramids, depth maps and their scratch images (about 1 MB each at 640x480) are
+  // allocated and freed every frame. Mapped and unmapped each time (glibc's default for
+  // large blocks), every page is faulted in again: measured, a third of the wall time of a
+  // run on this machine. They come from the heap, kept (not trimmed) between frames, at
+  // the price of RSS holding the peak of the short-lived buffers (docs/benchmarks.md,
+  // "Memory and the allocator").
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  mallopt(M_TRIM_THRESHOLD, 256 << 20);
+  mallopt(M_TOP_PAD, 64 << 20);
   // Every error reaches the user as one line on stderr and a non-zero exit, never a crash.
   try {
     return Run(argc, argv);
