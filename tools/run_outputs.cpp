@@ -103,7 +103,8 @@ void WriteStats(const std::string& path, const RunSummary& s) {
                        {"frames_tracked_live", s.mapping.frames_tracked_live},
                        {"frames_waiting_for_mapping", s.mapping.frames_mapped_waiting},
                        {"frames_waiting_for_keyframe", s.mapping.frames_waiting_for_keyframe},
-                       {"frames_skipped_by_mapping", s.mapping.frames_skipped_by_mapping}};
+                       {"frames_skipped_by_mapping", s.mapping.frames_skipped_by_mapping},
+                       {"shutdown_ms", s.shutdown_ms}};
   }
   std::ofstream out(path);
   if (!out) throw InputError(path, "cannot open for writing");

@@ -174,7 +174,11 @@ RunSummary RunDataset(const RunOptions& options) {
     }
     // Interrupted: what mapping has not reached is dropped (the keyframes made are kept);
     // otherwise every frame handed to mapping is mapped before the outputs.
+    const auto shutdown = std::chrono::steady_clock::now();
     summary.status == "interrupted" ? system.StopMapping() : system.FinishMapping();
+    summary.shutdown_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - shutdown)
+            .count();
   } catch (const std::exception& e) {
     // A fatal input error: what the map holds is still written, marked failed.
     system.StopMapping();

@@ -84,6 +84,9 @@ struct RunSummary {
   double rate = 0.0;
   int frames_dropped = 0;  ///< arrived while tracking was busy: never processed, no pose
   RealtimeStats mapping;   ///< frames tracked live, waiting for mapping, skipped by mapping
+  /// Wall time of the end of the run: FinishMapping (all input) or StopMapping (an
+  /// interrupt: waiting work dropped), ms.
+  double shutdown_ms = 0.0;
 };
 
 /// Reads the dataset, rectifies each image, runs System::ProcessFrame, and writes

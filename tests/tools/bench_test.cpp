@@ -59,6 +59,18 @@ TEST(BenchSuite, MinimalSuiteAndErrorsWithLines) {
   expect_line("sequences:\n  - {name: a, path: data/seq}\n  - {name: a, path: data/seq}\n", 3,
               "duplicate");
   expect_line("sequences:\n  - {name: a, synth: {scene: room, frames: 1}}\n", 2, "frames");
+  expect_line(
+      "sequences:\n  - {name: a, path: data/seq}\nconfigurations:\n"
+      "  - {name: live, realtime_rate: -1}\n",
+      4, "realtime_rate");
+  const Suite modes = ReadSuite(dir.Write("modes.yaml",
+                                          "sequences:\n  - {name: a, path: data/seq}\n"
+                                          "configurations:\n  - {name: deterministic}\n"
+                                          "  - {name: camera, realtime_rate: 1}\n"),
+                                dir.File("cache"));
+  ASSERT_EQ(modes.configurations.size(), 2u);
+  EXPECT_FALSE(modes.configurations[0].realtime_rate);
+  EXPECT_EQ(modes.configurations[1].realtime_rate, 1.0);
 }
 
 TEST(BenchRunner, FiguresMatchEvalAndParallelEqualsSerial) {

@@ -39,6 +39,9 @@ std::vector<std::string> RunArguments(const std::string& binary, const SequenceS
   if (!s.calibration.empty()) argv.insert(argv.end(), {"--calib", s.calibration});
   if (!s.config.empty()) argv.insert(argv.end(), {"--config", s.config});
   if (!c.config.empty()) argv.insert(argv.end(), {"--config", c.config});
+  if (c.realtime_rate) {
+    argv.insert(argv.end(), {"--realtime", "--rate", std::to_string(*c.realtime_rate)});
+  }
   if (s.max_frames > 0) argv.insert(argv.end(), {"--max-frames", std::to_string(s.max_frames)});
   return argv;
 }

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <filesystem>
 #include <set>
 
@@ -156,12 +157,18 @@ Suite ReadSuite(const std::string& file, const std::string& cache_dir) {
   if (const YAML::Node configurations = root["configurations"]) {
     std::set<std::string> config_names;
     for (const YAML::Node& node : configurations) {
-      r.CheckKeys(node, {"name", "config"});
+      r.CheckKeys(node, {"name", "config", "realtime_rate"});
       Configuration c;
       c.name = r.Get<std::string>(node, "name", "");
       if (c.name.empty()) r.Fail(node, "a configuration needs a 'name'");
       if (!config_names.insert(c.name).second) r.Fail(node, "duplicate configuration");
       c.config = r.PathOf(node, "config", true);
+      if (node["realtime_rate"]) {
+        c.realtime_rate = r.Get<double>(node, "realtime_rate", 0.0);
+        if (!(*c.realtime_rate >= 0.0) || !std::isfinite(*c.realtime_rate)) {
+          r.Fail(node["realtime_rate"], "'realtime_rate' must be a finite number >= 0");
+        }
+      }
       suite.configurations.push_back(c);
     }
   }

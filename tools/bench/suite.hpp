@@ -35,6 +35,9 @@ struct SequenceSpec {
 struct Configuration {
   std::string name = "default";
   std::string config;  ///< options YAML, optional (applied after the sequence's own)
+  /// Set: the runs are `parallax run --realtime --rate R` (docs/realtime.md; 0 = as fast as
+  /// tracking goes), so the report compares the modes on the same sequences.
+  std::optional<double> realtime_rate;
 };
 
 struct Suite {
