@@ -135,12 +135,12 @@ void KeyframeGraph::Compact(const std::vector<std::int64_t>& keep) {
 
 std::vector<Eigen::Vector3f> KeyframeGraph::MapPoints(const PinholeCamera& camera) const {
   std::vector<Eigen::Vector3f> points;
-  ForEachMapPoint(camera, [&](const Eigen::Vector3f& p) { points.push_back(p); });
+  ForEachMapPoint(camera, [&](const MapPoint& p) { points.push_back(p.p_w); });
   return points;
 }
 
 void KeyframeGraph::ForEachMapPoint(const PinholeCamera& camera,
-                                    const std::function<void(const Eigen::Vector3f&)>& fn) const {
+                                    const std::function<void(const MapPoint&)>& fn) const {
   for (const auto& [id, kf] : keyframes_) {
     const Sim3d& S_w_kf = Pose(id);
     const PinholeCamera& K = camera;
@@ -149,7 +149,8 @@ void KeyframeGraph::ForEachMapPoint(const PinholeCamera& camera,
       if (!d.confirmed[k]) continue;
       const Eigen::Vector2d px(d.pixel[k] % d.width, d.pixel[k] / d.width);
       const Eigen::Vector3d p = K.Unproject(px) / d.idepth[k];
-      fn((S_w_kf * p).cast<float>());
+      fn(MapPoint{(S_w_kf * p).cast<float>(),
+                  kf->image.Data()[static_cast<std::size_t>(d.pixel[k])]});
     }
   }
 }

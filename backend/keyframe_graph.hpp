@@ -62,6 +62,12 @@ std::shared_ptr<const Keyframe> Materialize(const std::shared_ptr<const Keyframe
                                             const PyramidOptions& pyramid,
                                             const TrackingReferenceOptions& reference);
 
+/// A confirmed semi-dense point in the world, with the grey level of its keyframe pixel.
+struct MapPoint {
+  Eigen::Vector3f p_w;
+  std::uint8_t intensity = 0;
+};
+
 /// Counts by edge kind.
 struct EdgeCounts {
   int odometry = 0;
@@ -114,9 +120,9 @@ class KeyframeGraph {
   /// World points of every keyframe's confirmed depth through its current pose; `camera`
   /// is the (level-0) camera of the keyframes.
   std::vector<Eigen::Vector3f> MapPoints(const PinholeCamera& camera) const;
-  /// The same points one at a time (no copy of the whole cloud).
+  /// The same points one at a time with their intensity (no copy of the whole cloud).
   void ForEachMapPoint(const PinholeCamera& camera,
-                       const std::function<void(const Eigen::Vector3f&)>& fn) const;
+                       const std::function<void(const MapPoint&)>& fn) const;
   /// Memory held by the keyframes (frozen depth, tracking references, frame pyramids).
   std::size_t Bytes() const;
   void Clear();

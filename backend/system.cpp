@@ -1,5 +1,6 @@
 #include "backend/system.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -472,28 +473,31 @@ FrameResult System::StartNewMap(const std::shared_ptr<const Frame>& frame, const
 
 std::vector<Eigen::Vector3f> System::MapPoints() const {
   std::vector<Eigen::Vector3f> all;
-  ForEachMapPoint([&](const Eigen::Vector3f& p) { all.push_back(p); });
+  ForEachMapPoint([&](const MapPoint& p) { all.push_back(p.p_w); });
   return all;
 }
 
-void System::ForEachMapPoint(const std::function<void(const Eigen::Vector3f&)>& fn) const {
+void System::ForEachMapPoint(const std::function<void(const MapPoint&)>& fn) const {
   const std::lock_guard<std::mutex> lock(engine_mutex_);
   ForEachMapPointLocked(fn);
 }
 
-void System::ForEachMapPointLocked(const std::function<void(const Eigen::Vector3f&)>& fn) const {
+void System::ForEachMapPointLocked(const std::function<void(const MapPoint&)>& fn) const {
   graph_.ForEachMapPoint(camera_, fn);
   if (mapper_.HasMap() && !graph_.Contains(current_.id)) {
     // The current keyframe's confirmed points, through its current pose.
     const InverseDepthMap& map = mapper_.Map();
     const Sim3d S_w_kf = CurrentKeyframePose();
     const PinholeCamera& K = map.Keyframe().Camera(0);
+    const PyramidLevel& image = map.Keyframe().Level(0);
     for (int y = 0; y < map.Height(); ++y) {
       for (int x = 0; x < map.Width(); ++x) {
         const std::size_t i = map.Index(x, y);
         if (!map.IsConfirmed(i)) continue;
         const Eigen::Vector3d p = K.Unproject(Eigen::Vector2d(x, y)) / map.idepth_smoothed[i];
-        fn((S_w_kf * p).cast<float>());
+        const auto grey =
+            static_cast<std::uint8_t>(std::lround(std::clamp(image.intensity(x, y), 0.0f, 255.0f)));
+        fn(MapPoint{(S_w_kf * p).cast<float>(), grey});
       }
     }
   }

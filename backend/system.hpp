@@ -292,8 +292,9 @@ class System {
   /// Semi-dense points of all keyframes (world coordinates), confirmed estimates only,
   /// through the keyframes' current (optimised) poses.
   std::vector<Eigen::Vector3f> MapPoints() const;
-  /// The same points one at a time (for writing large maps without copying them).
-  void ForEachMapPoint(const std::function<void(const Eigen::Vector3f&)>& fn) const;
+  /// The same points one at a time, with their grey level (for writing large maps without
+  /// copying them).
+  void ForEachMapPoint(const std::function<void(const MapPoint&)>& fn) const;
   /// Every frame that has a pose, in frame order, through its keyframe's current pose.
   std::vector<FramePose> Trajectory() const;
 
@@ -361,7 +362,7 @@ class System {
   void TakePendingEvents(FrameResult* result);
   FrameResult WaitForMapping(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
                              std::optional<LiveTracking> live, LiveTracking hint);
-  void ForEachMapPointLocked(const std::function<void(const Eigen::Vector3f&)>& fn) const;
+  void ForEachMapPointLocked(const std::function<void(const MapPoint&)>& fn) const;
   std::vector<std::uint8_t> EncodeMapBytesLocked() const;
   void StartKeyframe(const std::shared_ptr<const Frame>& frame, const Sim3d& S_w_kf,
                      InverseDepthMap map, FrameResult* result);

@@ -2,7 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <array>
+#include <bit>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -40,13 +43,20 @@ void WriteAtomically(const std::string& path, Write write) {
 /// Streams the map (two passes: count, then write): millions of points are never copied.
 std::size_t WritePly(const std::string& path, const System& system) {
   std::size_t count = 0;
-  system.ForEachMapPoint([&](const Eigen::Vector3f&) { ++count; });
-  std::ofstream out(path);
+  system.ForEachMapPoint([&](const MapPoint&) { ++count; });
+  std::ofstream out(path, std::ios::binary);
   if (!out) throw InputError(path, "cannot open for writing");
-  out << "ply\nformat ascii 1.0\nelement vertex " << count
-      << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
-  system.ForEachMapPoint([&](const Eigen::Vector3f& p) {
-    out << fmt::format("{:.5f} {:.5f} {:.5f}\n", p.x(), p.y(), p.z());
+  // Binary (15 bytes a point; ASCII took about 30 and seconds to write for millions of
+  // points); the grey level as equal red, green and blue, which every viewer shows.
+  out << "ply\nformat binary_little_endian 1.0\nelement vertex " << count
+      << "\nproperty float x\nproperty float y\nproperty float z\n"
+         "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
+  static_assert(std::endian::native == std::endian::little, "PLY is written little-endian");
+  std::array<char, 15> record{};
+  system.ForEachMapPoint([&](const MapPoint& p) {
+    std::memcpy(record.data(), p.p_w.data(), 12);
+    std::memset(record.data() + 12, p.intensity, 3);
+    out.write(record.data(), record.size());
   });
   if (!out) throw InputError(path, "write failed");
   return count;

@@ -6,9 +6,13 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 
 #include "temp_dir.hpp"
@@ -71,6 +75,36 @@ TEST_F(RunOutputsTest, StaleFilesOfAnEarlierRunAreRemoved) {
   EXPECT_TRUE(manifest["complete"].get<bool>());
   for (const auto& f : manifest["files"]) EXPECT_TRUE(fs::exists(out + "/" + f.get<std::string>()));
   EXPECT_FALSE(fs::exists(out + "/trajectory.txt.partial"));
+}
+
+// map.ply is binary: a header any PLY reader takes, then one 15-byte record a point
+// (x, y, z as little-endian floats, the grey level as red = green = blue).
+TEST_F(RunOutputsTest, TheMapIsABinaryPlyWithTheGreyLevelOfEachPoint) {
+  const std::string out = dir_->File("ply");
+  RunOptions run;
+  run.dataset = dir_->File("room");
+  run.out_dir = out;
+  const RunSummary summary = RunDataset(run);
+  ASSERT_GT(summary.map_points, 1000u);
+  std::ifstream in(out + "/map.ply", std::ios::binary);
+  std::string line, header;
+  while (std::getline(in, line) && line != "end_header") header += line + "\n";
+  EXPECT_EQ(header, "ply\nformat binary_little_endian 1.0\nelement vertex " +
+                        std::to_string(summary.map_points) +
+                        "\nproperty float x\nproperty float y\nproperty float z\n"
+                        "property uchar red\nproperty uchar green\nproperty uchar blue\n");
+  std::vector<char> records((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_EQ(records.size(), summary.map_points * 15);
+  std::set<int> greys;
+  for (std::size_t k = 0; k < summary.map_points; ++k) {
+    float xyz[3];
+    std::memcpy(xyz, records.data() + 15 * k, sizeof(xyz));
+    for (const float v : xyz) ASSERT_TRUE(std::isfinite(v));
+    const auto* rgb = reinterpret_cast<const std::uint8_t*>(records.data() + 15 * k + 12);
+    ASSERT_TRUE(rgb[0] == rgb[1] && rgb[1] == rgb[2]);
+    greys.insert(rgb[0]);
+  }
+  EXPECT_GT(greys.size(), 50u);  // the room's texture, not a constant
 }
 
 TEST_F(RunOutputsTest, ACorruptFrameIsSkippedAndReported) {

@@ -138,8 +138,8 @@ std::optional<px_event> Session::PollEvent(std::uint64_t* dropped) {
 std::vector<float> Session::MapPoints() const {
   RequireUsable();
   std::vector<float> xyz;
-  system_->ForEachMapPoint([&](const Eigen::Vector3f& p) {
-    xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
+  system_->ForEachMapPoint([&](const MapPoint& p) {
+    xyz.insert(xyz.end(), {p.p_w.x(), p.p_w.y(), p.p_w.z()});
   });
   return xyz;
 }
