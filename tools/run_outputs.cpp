@@ -105,7 +105,8 @@ void WriteStats(const std::string& path, const RunSummary& s) {
       {"latency_ms",
        {{"p50", s.latency_ms_p50}, {"p95", s.latency_ms_p95}, {"max", s.latency_ms_max}}},
       {"map_points", s.map_points},
-      {"peak_rss_mb", s.peak_rss_mb}};
+      {"peak_rss_mb", s.peak_rss_mb},
+      {"photometric_correction", s.photometric}};
   nlohmann::json all = j;
   if (s.realtime) {
     all["realtime"] = {{"rate", s.rate},

@@ -16,6 +16,7 @@
 #include "tools/dataset/camera_playback.hpp"
 #include "tools/dataset/frame_prefetcher.hpp"
 #include "tools/dataset/input_error.hpp"
+#include "tools/dataset/photometric_corrector.hpp"
 #include "tools/dataset/trajectory.hpp"
 #include "tools/run_outputs.hpp"
 
@@ -133,7 +134,14 @@ RunSummary RunDataset(const RunOptions& options) {
   summary.rate = summary.realtime ? options.rate : 0.0;
   const auto start = std::chrono::steady_clock::now();
   const std::size_t num_frames = reader->NumFrames();  // the reader belongs to `frames` now
-  FramePrefetcher frames(reader.get(), &undistorter, 4, !options.fatal_unreadable);
+  std::optional<PhotometricCorrector> photometric;
+  if (const auto calibration = reader->Photometric(); calibration && options.photometric) {
+    // Checked when the dataset was opened (errors name its files).
+    photometric.emplace(*calibration, reader->GetCamera().Width(), reader->GetCamera().Height());
+  }
+  summary.photometric = photometric && photometric->Enabled();
+  FramePrefetcher frames(reader.get(), &undistorter, 4, !options.fatal_unreadable,
+                         photometric ? &*photometric : nullptr);
   FrameSource source(&frames, options);
   const auto log_dropped = [&] {
     for (const auto& [index, timestamp] : source.TakeDropped()) {

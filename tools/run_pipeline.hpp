@@ -31,6 +31,9 @@ struct RunOptions {
   /// An unreadable or corrupt image is skipped and reported (frames.csv, stats.json); with
   /// this it ends the run instead (its outputs are still written, marked failed).
   bool fatal_unreadable = false;
+  /// Apply the dataset's photometric calibration (TUM monoVO response and vignette) when it
+  /// has one (docs/datasets.md).
+  bool photometric = true;
   /// Real-time mode (system.realtime.enabled): frames are played back at their timestamps
   /// divided by this (CameraPlayback; frames arriving while tracking is busy are dropped);
   /// 0 feeds them as fast as tracking takes them.
@@ -87,6 +90,7 @@ struct RunSummary {
   /// Wall time of the end of the run: FinishMapping (all input) or StopMapping (an
   /// interrupt: waiting work dropped), ms.
   double shutdown_ms = 0.0;
+  bool photometric = false;  ///< the images were photometrically corrected
 };
 
 /// Reads the dataset, rectifies each image, runs System::ProcessFrame, and writes

@@ -54,7 +54,7 @@ class Reader {
 
   synth::SynthOptions Synth(const YAML::Node& node) const {
     CheckKeys(node, {"scene", "motion", "frames", "seed", "fps", "exposure", "noise", "vignette",
-                     "blur", "width", "height"});
+                     "blur", "width", "height", "gamma", "layout"});
     synth::SynthOptions o;
     o.scene = Get<std::string>(node, "scene", o.scene);
     o.motion = Get<std::string>(node, "motion", o.motion);
@@ -67,6 +67,8 @@ class Reader {
     o.blur = Get<bool>(node, "blur", o.blur);
     o.width = Get<int>(node, "width", o.width);
     o.height = Get<int>(node, "height", o.height);
+    o.response_gamma = Get<double>(node, "gamma", o.response_gamma);
+    o.layout = Get<std::string>(node, "layout", o.layout);
     try {
       o.Check();
     } catch (const std::invalid_argument& e) {
@@ -95,10 +97,12 @@ class Reader {
 
 /// A folder name that changes with every parameter of the rendering.
 std::string CacheName(const synth::SynthOptions& o) {
-  return fmt::format("{}-{}-{}f-seed{}-{}fps-{}x{}{}{}{}{}", o.scene, o.motion, o.frames, o.seed,
-                     o.fps, o.width, o.height, o.exposure ? "-exposure" : "",
+  return fmt::format("{}-{}-{}f-seed{}-{}fps-{}x{}{}{}{}{}{}{}", o.scene, o.motion, o.frames,
+                     o.seed, o.fps, o.width, o.height, o.exposure ? "-exposure" : "",
                      o.noise_sigma > 0 ? fmt::format("-noise{}", o.noise_sigma) : "",
-                     o.vignette ? "-vignette" : "", o.blur ? "-blur" : "");
+                     o.vignette ? "-vignette" : "", o.blur ? "-blur" : "",
+                     o.response_gamma != 1.0 ? fmt::format("-gamma{}", o.response_gamma) : "",
+                     o.layout != "tum_rgbd" ? "-" + o.layout : "");
 }
 
 }  // namespace

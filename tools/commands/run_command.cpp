@@ -46,6 +46,9 @@ void AddRunCommand(CLI::App& app, int* exit_code) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--fatal-unreadable", options->fatal_unreadable,
                 "an unreadable image ends the run (default: skipped and reported)");
+  cmd->add_flag("--no-photometric{false}", options->photometric,
+                "ignore the dataset's photometric calibration (TUM monoVO pcalib.txt, "
+                "vignette.png; applied by default)");
   auto trajectory_format = std::make_shared<std::string>("tum");
   cmd->add_option("--trajectory-format", *trajectory_format,
                   "trajectory files as tum, or kitti (+ <name>.times.txt)")

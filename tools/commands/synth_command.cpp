@@ -30,6 +30,13 @@ void AddSynthCommand(CLI::App& app, int* exit_code) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--vignette", options->vignette, "radial vignetting");
   cmd->add_flag("--blur", options->blur, "motion blur");
+  cmd->add_option("--gamma", options->response_gamma,
+                  "camera response: grey = 255 (E / 255)^(1 / gamma) (1: linear)")
+      ->check(CLI::Range(0.2, 5.0));
+  cmd->add_option("--layout", options->layout,
+                  "tum_rgbd (default) | tum_mono (images/, times.txt with exposures, camera.txt, "
+                  "pcalib.txt, vignette.png)")
+      ->check(CLI::IsMember({"tum_rgbd", "tum_mono"}));
   cmd->add_option("--texture", options->textures, "image file(s) replacing procedural textures")
       ->check(CLI::ExistingFile);
   cmd->callback([options, out_dir, exit_code] {

@@ -8,9 +8,11 @@
 namespace parallax {
 
 FramePrefetcher::FramePrefetcher(DatasetReader* reader, const Undistorter* undistorter,
-                                 std::size_t capacity, bool skip_unreadable)
+                                 std::size_t capacity, bool skip_unreadable,
+                                 const PhotometricCorrector* photometric)
     : reader_(reader),
       undistorter_(undistorter),
+      photometric_(photometric),
       capacity_(capacity),
       skip_unreadable_(skip_unreadable) {
   CheckArgument(reader_ != nullptr && undistorter_ != nullptr,
@@ -43,6 +45,7 @@ void FramePrefetcher::ReadAhead() {
         prepared.emplace();
         prepared->index = frame->index;
         prepared->timestamp = frame->timestamp;
+        if (photometric_ != nullptr) photometric_->Apply(frame->image, &frame->image);
         undistorter_->Apply(frame->image, &prepared->image);
       }
     } catch (const InputError& e) {

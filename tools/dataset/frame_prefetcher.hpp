@@ -13,6 +13,7 @@
 
 #include "core/undistorter.hpp"
 #include "tools/dataset/dataset_reader.hpp"
+#include "tools/dataset/photometric_corrector.hpp"
 
 namespace parallax {
 
@@ -36,8 +37,10 @@ class FramePrefetcher {
   /// `reader` and `undistorter` must outlive this object and are used by its thread only.
   /// With `skip_unreadable`, an unreadable or corrupt image (InputError from the reader) comes
   /// out as a frame with `error` set and reading goes on; otherwise Next() rethrows it.
+  /// `photometric` (may be null; must outlive this object) undoes the response and vignette
+  /// before undistortion.
   FramePrefetcher(DatasetReader* reader, const Undistorter* undistorter, std::size_t capacity = 4,
-                  bool skip_unreadable = false);
+                  bool skip_unreadable = false, const PhotometricCorrector* photometric = nullptr);
   ~FramePrefetcher();
   FramePrefetcher(const FramePrefetcher&) = delete;
   FramePrefetcher& operator=(const FramePrefetcher&) = delete;
@@ -50,6 +53,7 @@ class FramePrefetcher {
 
   DatasetReader* reader_;
   const Undistorter* undistorter_;
+  const PhotometricCorrector* photometric_;
   std::size_t capacity_;
   bool skip_unreadable_;
   std::vector<double> timestamps_;  ///< of every frame, when the reader knows them

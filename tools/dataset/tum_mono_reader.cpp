@@ -9,7 +9,9 @@
 #include "tools/dataset/calibration_yaml.hpp"
 #include "tools/dataset/file_list_reader.hpp"
 #include "tools/dataset/input_error.hpp"
+#include "tools/dataset/photometric_corrector.hpp"
 #include "tools/dataset/text_lines.hpp"
+#include "tools/dataset/trajectory.hpp"
 
 namespace fs = std::filesystem;
 
@@ -125,6 +127,16 @@ PhotometricCalibration ReadPhotometric(const fs::path& folder, const Camera& cam
     }
     photometric.vignette = std::move(image);
   }
+  // The corrector's checks, each with its file named.
+  const auto check = [&](const PhotometricCalibration& part, const std::string& file) {
+    try {
+      const PhotometricCorrector corrector(part, camera.Width(), camera.Height());
+    } catch (const std::invalid_argument& e) {
+      throw InputError(file, e.what());
+    }
+  };
+  check(PhotometricCalibration{photometric.inverse_response, std::nullopt}, pcalib);
+  check(PhotometricCalibration{{}, photometric.vignette}, vignette);
   return photometric;
 }
 
@@ -173,6 +185,10 @@ std::unique_ptr<DatasetReader> OpenTumMono(const std::string& path,
                                 " files");
   }
   spec.photometric = ReadPhotometric(folder, *spec.camera);
+  // Not part of the TUM monoVO layout (it gives start and end segments only); rendered
+  // sequences in this layout write one (parallax synth --layout tum_mono).
+  const std::string gt = (folder / "groundtruth.txt").string();
+  if (fs::exists(gt)) spec.groundtruth = [gt] { return ReadTumTrajectory(gt); };
   return std::make_unique<FileListReader>(std::move(spec));
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// Writing a rendered sequence in the TUM RGB-D layout (docs/synthetic.md).
+// Writing a rendered sequence in the TUM RGB-D or monoVO layout (docs/synthetic.md).
 
 #include <cstdint>
 #include <string>
@@ -26,6 +26,13 @@ struct SynthOptions {
   bool vignette = false;              ///< radial fall-off to ~55% in the corners
   bool blur = false;                  ///< motion blur: 5 sub-frames over 40% of the frame interval
   std::vector<std::string> textures;  ///< image files replacing procedural textures
+  /// Camera response: stored grey = 255 (E / 255)^(1 / gamma) of the exposed irradiance E
+  /// (1: linear). tum_mono writes its inverse to pcalib.txt.
+  double response_gamma = 1.0;
+  /// "tum_rgbd" (rgb/, depth/, rgb.txt, calibration.yaml) or "tum_mono" (images/, times.txt
+  /// with exposure times, camera.txt, pcalib.txt, vignette.png with --vignette), both with
+  /// groundtruth.txt.
+  std::string layout = "tum_rgbd";
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;
@@ -54,8 +61,10 @@ struct SynthSummary {
   double render_seconds = 0.0;
 };
 
-/// Renders and writes out_dir/{rgb/, depth/, rgb.txt, depth.txt, groundtruth.txt,
-/// calibration.yaml}. Throws InputError if out_dir cannot be written.
+/// Renders and writes out_dir in `options.layout`: tum_rgbd {rgb/, depth/, rgb.txt,
+/// depth.txt, groundtruth.txt, calibration.yaml} or tum_mono {images/, times.txt,
+/// camera.txt, pcalib.txt, vignette.png, groundtruth.txt}. Throws InputError if out_dir
+/// cannot be written.
 SynthSummary WriteSyntheticSequence(const SynthOptions& options, const std::string& out_dir);
 
 }  // namespace parallax::synth
