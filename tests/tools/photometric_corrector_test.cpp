@@ -59,7 +59,7 @@ TEST(PhotometricCorrector, UndoesTheResponseAndTheVignette) {
 }
 
 TEST(PhotometricCorrector, RefusesCalibrationsThatCannotBeRight) {
-  const auto refused = [](PhotometricCalibration c, const std::string& fragment) {
+  const auto refused = [](const PhotometricCalibration& c, const std::string& fragment) {
     try {
       const PhotometricCorrector corrector(c, 8, 6);
       ADD_FAILURE() << "accepted: " << fragment;
