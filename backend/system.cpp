@@ -64,6 +64,7 @@ System::System(const PinholeCamera& camera, const SystemOptions& options)
       loop_closer_(options.loop_closure, &place_, camera),
       relocalizer_(options.relocalization, camera) {
   options_.Check();
+  chain_information_ = backend_.FallbackInformation();
   if (options_.realtime.enabled) StartRealtime();
 }
 

@@ -35,7 +35,6 @@ void RealtimeOptions::Check() const {
 void System::StartRealtime() {
   cv::setNumThreads(options_.realtime.opencv_threads);
   live_ = std::make_unique<LiveTracker>(options_.tracker, options_.realtime.tracking_threads);
-  chain_information_ = backend_.FallbackInformation();
   backend_worker_ = std::make_unique<BackendWorker>([this] { RunBackendBatch(); },
                                                     options_.realtime.backend_threads,
                                                     options_.realtime.backend_nice);
