@@ -6,12 +6,8 @@
 
 namespace parallax {
 
-MappingWorker::MappingWorker(Process process, std::size_t max_pending, int threads,
-                             int urgent_threads)
-    : process_(std::move(process)),
-      max_pending_(max_pending),
-      arena_(threads),
-      urgent_arena_(std::max(threads, urgent_threads)) {
+MappingWorker::MappingWorker(Process process, std::size_t max_pending, int threads)
+    : process_(std::move(process)), max_pending_(max_pending), arena_(threads) {
   CheckArgument(max_pending_ >= 1, "MappingWorker: max_pending must be >= 1");
   thread_ = std::thread([this] { Loop(); });
 }
@@ -108,7 +104,7 @@ void MappingWorker::Loop() {
     const bool waited = entry.done != nullptr;
     std::exception_ptr error;
     std::optional<FrameResult> result;
-    (waited || entry.job.keep ? urgent_arena_ : arena_).execute([&] {
+    arena_.execute([&] {
       try {
         result = process_(entry.job);
       } catch (...) {

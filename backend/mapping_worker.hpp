@@ -50,10 +50,8 @@ class MappingWorker {
   using Process = std::function<FrameResult(const MappingJob&)>;
 
   /// `process` maps a job. `max_pending`: refinement jobs that may wait (>= 1); `threads`:
-  /// the TBB concurrency of the thread's arena; `urgent_threads` (>= threads): of the arena
-  /// for jobs the caller waits for or will soon (a keyframe request): their parallel loops
-  /// may use the caller's core, which is idle or about to be. The thread starts here.
-  MappingWorker(Process process, std::size_t max_pending, int threads, int urgent_threads);
+  /// the TBB concurrency of the thread's arena. The thread starts here.
+  MappingWorker(Process process, std::size_t max_pending, int threads);
   /// Stop().
   ~MappingWorker();
   MappingWorker(const MappingWorker&) = delete;
@@ -89,7 +87,6 @@ class MappingWorker {
   Process process_;
   std::size_t max_pending_;
   tbb::task_arena arena_;
-  tbb::task_arena urgent_arena_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;  ///< a job was queued, or stop
   std::condition_variable idle_;  ///< a job finished

@@ -41,8 +41,7 @@ void System::StartRealtime() {
   worker_ = std::make_unique<MappingWorker>(
       [this](const MappingJob& job) { return MapJob(job); },
       static_cast<std::size_t>(options_.realtime.max_pending_frames),
-      options_.realtime.mapping_threads,
-      options_.realtime.mapping_threads + options_.realtime.tracking_threads);
+      options_.realtime.mapping_threads);
 }
 
 System::~System() { StopMapping(); }

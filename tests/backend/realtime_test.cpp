@@ -50,7 +50,7 @@ struct GatedProcess {
 
 TEST(MappingWorker, WhenBehindTheOldestWaitingRefinementIsSkipped) {
   GatedProcess process;
-  MappingWorker worker(process.Function(), 1, 1, 2);
+  MappingWorker worker(process.Function(), 1, 1);
   worker.Offer(Job(0));  // taken by the thread, blocked at the gate (or still queued)
   for (int id = 1; id <= 5; ++id) worker.Offer(Job(id));
   MappingJob kept = Job(6);
@@ -69,7 +69,7 @@ TEST(MappingWorker, WhenBehindTheOldestWaitingRefinementIsSkipped) {
 TEST(MappingWorker, AWaitedJobRunsAfterTheQueuedOnesAndExceptionsReachTheCaller) {
   GatedProcess process;
   process.open.set_value();
-  MappingWorker worker(process.Function(), 4, 1, 2);
+  MappingWorker worker(process.Function(), 4, 1);
   worker.Offer(Job(1));
   worker.Run(Job(2));
   EXPECT_EQ(process.seen, (std::vector<std::int64_t>{1, 2}));
@@ -83,7 +83,7 @@ TEST(MappingWorker, AWaitedJobRunsAfterTheQueuedOnesAndExceptionsReachTheCaller)
 
 TEST(MappingWorker, StopDropsWaitingJobsAndRefusesNewOnes) {
   GatedProcess process;
-  MappingWorker worker(process.Function(), 8, 1, 2);
+  MappingWorker worker(process.Function(), 8, 1);
   for (int id = 0; id < 5; ++id) worker.Offer(Job(id));
   std::thread opener([&] { process.open.set_value(); });
   worker.Stop();
@@ -95,7 +95,7 @@ TEST(MappingWorker, StopDropsWaitingJobsAndRefusesNewOnes) {
 
 TEST(MappingWorker, AKeyframeRequestGoesBeforeWaitingRefinementsAndCanBeWaitedFor) {
   GatedProcess process;
-  MappingWorker worker(process.Function(), 4, 1, 2);
+  MappingWorker worker(process.Function(), 4, 1);
   worker.Offer(Job(0));
   worker.Offer(Job(1));
   worker.Offer(Job(2));
@@ -120,7 +120,7 @@ TEST(MappingWorker, AKeyframeRequestGoesBeforeWaitingRefinementsAndCanBeWaitedFo
 
 TEST(MappingWorker, AWaitForEndsWhenTheWorkerStops) {
   GatedProcess process;
-  MappingWorker worker(process.Function(), 4, 1, 2);
+  MappingWorker worker(process.Function(), 4, 1);
   MappingJob kept = Job(5);
   kept.keep = true;
   worker.Offer(std::move(kept));
