@@ -47,10 +47,7 @@ std::vector<std::uint8_t> System::EncodeMapBytesLocked() const {
   AddChainEdges(&graph, backend_pending_);
   if (mapper_.HasMap() && !graph.Contains(current_.id)) {
     graph.Upsert(mapper_.Freeze(), CurrentKeyframePose(), current_map_);
-    if (current_.parent && graph.Contains(*current_.parent)) {
-      graph.AddEdge(PoseGraphEdge{*current_.parent, current_.id, current_.S_parent_kf,
-                                  chain_information_, EdgeKind::kOdometry});
-    }
+    AddChainEdges(&graph, {FinishedKeyframe{current_.id, current_.parent, current_.S_parent_kf}});
   }
   // Keyframes described only here (place recognition off, or the current one) keep their
   // entries alive until the map is encoded.

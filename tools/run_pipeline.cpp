@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/check.hpp"
+#include "core/stopwatch.hpp"
 #include "core/undistorter.hpp"
 #include "tools/dataset/camera_playback.hpp"
 #include "tools/dataset/frame_prefetcher.hpp"
@@ -140,8 +141,9 @@ RunSummary RunDataset(const RunOptions& options) {
     photometric.emplace(*calibration, reader->GetCamera().Width(), reader->GetCamera().Height());
   }
   summary.photometric = photometric && photometric->Enabled();
+  // A calibration with nothing in it (no pcalib.txt, no vignette.png) is not applied.
   FramePrefetcher frames(reader.get(), &undistorter, 4, !options.fatal_unreadable,
-                         photometric ? &*photometric : nullptr);
+                         summary.photometric ? &*photometric : nullptr);
   FrameSource source(&frames, options);
   const auto log_dropped = [&] {
     for (const auto& [index, timestamp] : source.TakeDropped()) {
@@ -167,11 +169,9 @@ RunSummary RunDataset(const RunOptions& options) {
         outputs.LogUnreadable(static_cast<int>(frame->index), frame->timestamp, frame->error);
         continue;
       }
-      const auto call = std::chrono::steady_clock::now();
+      const auto call = StageClock::now();
       const FrameResult result = system.ProcessFrame(frame->image, frame->timestamp);
-      timings.latency_ms.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - call)
-              .count());
+      timings.latency_ms.push_back(MillisecondsSince(call));
       outputs.LogFrame(static_cast<int>(frame->index), frame->timestamp, result);
       timings.tracking_ms.push_back(result.tracking_ms);
       timings.mapping_ms.push_back(result.mapping_ms);
@@ -182,11 +182,9 @@ RunSummary RunDataset(const RunOptions& options) {
     }
     // Interrupted: what mapping has not reached is dropped (the keyframes made are kept);
     // otherwise every frame handed to mapping is mapped before the outputs.
-    const auto shutdown = std::chrono::steady_clock::now();
+    const auto shutdown = StageClock::now();
     summary.status == "interrupted" ? system.StopMapping() : system.FinishMapping();
-    summary.shutdown_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - shutdown)
-            .count();
+    summary.shutdown_ms = MillisecondsSince(shutdown);
   } catch (const std::exception& e) {
     // A fatal input error: what the map holds is still written, marked failed.
     system.StopMapping();
