@@ -279,9 +279,13 @@ class System {
   /// of the mapping thread come with the next result; an exception the mapping thread threw
   /// is rethrown here.
   FrameResult ProcessFrame(const ImageU8& image, double timestamp);
-  /// Real-time mode: returns when every frame handed to mapping is mapped (then Graph() and
-  /// the outputs are final). No-op in the deterministic mode.
-  void FinishMapping();
+  /// The end of the input. Real-time mode: first waits until every frame handed to mapping
+  /// is mapped and the backend is idle. Both modes: then the current keyframe goes through
+  /// the backend as a finished one would (constraint search, place recognition, loop
+  /// closure), so that a sequence ending where it began can close its loop; it stays the
+  /// current keyframe, and frames given later continue on it. Returns the events no frame
+  /// has reported yet. Graph() and the outputs are final afterwards.
+  std::vector<SystemEvent> FinishMapping();
   /// Real-time mode: drops the frames waiting for mapping, lets the running one finish and
   /// stops the thread (keyframes already made are kept; later frames are refused).
   void StopMapping();
@@ -486,6 +490,7 @@ class System {
     kRelocalising,  ///< a loaded map: every frame is relocalised on it until one is found
   };
   StartState start_ = StartState::kNoKeyframe;
+  bool mapping_stopped_ = false;  ///< real-time mode: StopMapping ran (no backend left)
   FrameTracker tracker_;
   Mapper mapper_;
   GraphBackend backend_;

@@ -46,10 +46,24 @@ void System::StartRealtime() {
 
 System::~System() { StopMapping(); }
 
-void System::FinishMapping() {
-  if (!worker_) return;
-  worker_->Drain();  // mapping first: it may finish keyframes for the backend
-  backend_worker_->Drain();
+std::vector<SystemEvent> System::FinishMapping() {
+  FrameResult last;
+  if (worker_) {
+    worker_->Drain();  // mapping first: it may finish keyframes for the backend
+    backend_worker_->Drain();
+  }
+  {
+    const std::lock_guard<std::mutex> engine(engine_mutex_);
+    // A keyframe is finished again only when it was (a relocalisation's target): its image
+    // is in the place database and its edges exist, so nothing repeats.
+    // After StopMapping the backend is gone: the map stays as it was stopped.
+    if (start_ == StartState::kInitialised && !mapping_stopped_) FinishCurrentKeyframe(&last);
+  }
+  if (worker_) backend_worker_->Drain();
+  const std::lock_guard<std::mutex> pending(poses_mutex_);
+  last.events.insert(last.events.begin(), pending_events_.begin(), pending_events_.end());
+  pending_events_.clear();
+  return last.events;
 }
 
 void System::StopMapping() {
@@ -59,6 +73,7 @@ void System::StopMapping() {
   // Keyframes the backend never reached keep the chain tracking made (no keyframe made is
   // lost; they are only not optimised).
   const std::lock_guard<std::mutex> lock(engine_mutex_);
+  mapping_stopped_ = true;
   AddChainEdges(&graph_, std::exchange(backend_pending_, {}));
 }
 

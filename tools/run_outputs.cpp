@@ -106,7 +106,8 @@ void WriteStats(const std::string& path, const RunSummary& s) {
        {{"p50", s.latency_ms_p50}, {"p95", s.latency_ms_p95}, {"max", s.latency_ms_max}}},
       {"map_points", s.map_points},
       {"peak_rss_mb", s.peak_rss_mb},
-      {"photometric_correction", s.photometric}};
+      {"photometric_correction", s.photometric},
+      {"end_of_input_events", s.end_events}};
   nlohmann::json all = j;
   if (s.realtime) {
     all["realtime"] = {{"rate", s.rate},
@@ -121,6 +122,10 @@ void WriteStats(const std::string& path, const RunSummary& s) {
   if (!out) throw InputError(path, "cannot open for writing");
   out << all.dump(2) << "\n";
 }
+
+std::string TimestampText(double t) { return std::isfinite(t) ? FormatTimestamp(t) : "nan"; }
+
+}  // namespace
 
 std::string EventNames(const std::vector<SystemEvent>& events) {
   std::string names;
@@ -164,10 +169,6 @@ std::string EventNames(const std::vector<SystemEvent>& events) {
   }
   return names;
 }
-
-std::string TimestampText(double t) { return std::isfinite(t) ? FormatTimestamp(t) : "nan"; }
-
-}  // namespace
 
 RunOutputs::RunOutputs(const std::string& out_dir, RunOptions::TrajectoryFormat format,
                        const std::string& dataset)

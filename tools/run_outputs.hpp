@@ -14,6 +14,9 @@
 
 namespace parallax {
 
+/// Events in frames.csv's notation: `finished;optimised;loop:<keyframe id>;...`.
+std::string EventNames(const std::vector<SystemEvent>& events);
+
 class RunOutputs {
  public:
   /// Creates `out_dir` (throws InputError naming it when it cannot be created or written),

@@ -183,7 +183,11 @@ RunSummary RunDataset(const RunOptions& options) {
     // Interrupted: what mapping has not reached is dropped (the keyframes made are kept);
     // otherwise every frame handed to mapping is mapped before the outputs.
     const auto shutdown = StageClock::now();
-    summary.status == "interrupted" ? system.StopMapping() : system.FinishMapping();
+    if (summary.status == "interrupted") {
+      system.StopMapping();
+    } else {
+      summary.end_events = EventNames(system.FinishMapping());
+    }
     summary.shutdown_ms = MillisecondsSince(shutdown);
   } catch (const std::exception& e) {
     // A fatal input error: what the map holds is still written, marked failed.

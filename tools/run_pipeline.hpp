@@ -90,6 +90,9 @@ struct RunSummary {
   /// Wall time of the end of the run: FinishMapping (all input) or StopMapping (an
   /// interrupt: waiting work dropped), ms.
   double shutdown_ms = 0.0;
+  /// Events of the end of the input (the last keyframe finished, a loop it closed), in
+  /// frames.csv's notation; no frame row reports them.
+  std::string end_events;
   bool photometric = false;  ///< the images were photometrically corrected
 };
 

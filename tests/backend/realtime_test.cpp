@@ -240,6 +240,10 @@ TEST(Realtime, SystemsStoppedOrDestroyedMidStreamKeepTheirKeyframes) {
     }
     EXPECT_THROW(system.ProcessFrame(test::RenderTestImage(Room(), OrbitPose(frames)), 99.0),
                  std::logic_error);
+    // The end of the input after a stop: no backend runs, the map is as it was stopped.
+    const std::size_t edges = graph.Poses().Edges().size();
+    EXPECT_NO_THROW(system.FinishMapping());
+    EXPECT_EQ(system.Graph().Poses().Edges().size(), edges);
   }
 }
 
