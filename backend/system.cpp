@@ -247,7 +247,9 @@ FrameResult System::ProcessFrame(const ImageU8& image, double timestamp) {
                 "System::ProcessFrame: image is " + std::to_string(image.Width()) + "x" +
                     std::to_string(image.Height()) + ", the camera " +
                     std::to_string(camera_.Width()) + "x" + std::to_string(camera_.Height()));
-  const FrameQuality quality = AssessFrame(image, options_.quality);
+  const FrameQuality quality =
+      AssessFrame(image, options_.quality,
+                  camera_.Validity() != nullptr ? &camera_.Validity()->Level(0) : nullptr);
   const std::int64_t id = frame_count_++;
   {
     const std::lock_guard<std::mutex> lock(poses_mutex_);

@@ -27,6 +27,7 @@
 #include "core/image.hpp"
 #include "core/pinhole_camera.hpp"
 #include "core/sim3.hpp"
+#include "core/validity_mask.hpp"
 #include "depth/depth_filter.hpp"
 #include "tracking/se3_tracker.hpp"
 #include "tracking/tracking_reference.hpp"

@@ -21,7 +21,10 @@ const ImageU8& CheckedImage(const ImageU8& image, const PinholeCamera& camera) {
 
 Frame::Frame(std::int64_t id, double timestamp, const PinholeCamera& camera, const ImageU8& image,
              const PyramidOptions& pyramid_options)
-    : id_(id), timestamp_(timestamp), pyramid_(CheckedImage(image, camera), pyramid_options) {
+    : id_(id),
+      timestamp_(timestamp),
+      validity_(camera.Validity()),
+      pyramid_(CheckedImage(image, camera), pyramid_options, validity_.get()) {
   CheckArgument(std::isfinite(timestamp), "Frame: timestamp must be finite");
   cameras_.reserve(static_cast<std::size_t>(pyramid_.NumLevels()));
   for (int level = 0; level < pyramid_.NumLevels(); ++level) {

@@ -2,6 +2,7 @@
 // An input image prepared for tracking and mapping.
 
 #include <cstdint>
+#include <memory>
 #include <mutex>
 
 #include "core/image.hpp"
@@ -38,6 +39,7 @@ class Frame {
  private:
   std::int64_t id_;
   double timestamp_;
+  std::shared_ptr<const ValidityMask> validity_;  ///< before pyramid_: its levels view it
   ImagePyramid pyramid_;
   std::vector<PinholeCamera> cameras_;
   mutable std::once_flag max_gradient_once_;

@@ -41,7 +41,11 @@ std::string FrameQuality::Reason() const {
   return s.str();
 }
 
-FrameQuality AssessFrame(const ImageU8& image, const FrameQualityOptions& options) {
+FrameQuality AssessFrame(const ImageU8& image, const FrameQualityOptions& options,
+                         const ImageU8* valid) {
+  CheckArgument(
+      valid == nullptr || (valid->Width() == image.Width() && valid->Height() == image.Height()),
+      "AssessFrame: the validity mask's size differs from the image's");
   FrameQuality q;
   if (image.Width() < options.min_size || image.Height() < options.min_size) {
     q.usability = FrameUsability::kTooSmall;
@@ -52,7 +56,9 @@ FrameQuality AssessFrame(const ImageU8& image, const FrameQualityOptions& option
   for (int y = 0; y + 1 < image.Height(); y += options.step) {
     const std::uint8_t* row = image.Row(y);
     const std::uint8_t* below = image.Row(y + 1);
+    const std::uint8_t* seen = valid != nullptr ? valid->Row(y) : nullptr;
     for (int x = 0; x + 1 < image.Width(); x += options.step) {
+      if (seen != nullptr && seen[x] == 0) continue;  // no input there (eroded: neighbours too)
       const double v = row[x];
       sum += v;
       sum_sq += v * v;
@@ -61,6 +67,10 @@ FrameQuality AssessFrame(const ImageU8& image, const FrameQualityOptions& option
       saturated += v >= 250.0;
       n += 1.0;
     }
+  }
+  if (n == 0.0) {  // nothing of the image sees the scene
+    q.usability = FrameUsability::kBlank;
+    return q;
   }
   q.mean = sum / n;
   const double variance = std::max(sum_sq / n - q.mean * q.mean, 0.0);

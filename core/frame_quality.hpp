@@ -41,6 +41,9 @@ struct FrameQuality {
   std::string Reason() const;
 };
 
-FrameQuality AssessFrame(const ImageU8& image, const FrameQualityOptions& options = {});
+/// `valid` (optional, the image's size): only its nonzero pixels are examined (a `full`
+/// rectification's black border is neither contrast nor correlation); none: blank.
+FrameQuality AssessFrame(const ImageU8& image, const FrameQualityOptions& options = {},
+                         const ImageU8* valid = nullptr);
 
 }  // namespace parallax

@@ -62,6 +62,14 @@ void ComputeGradients(const Plane& I, const Plane& dx, const Plane& dy, const Pl
   }
 }
 
+// No texture where no input is: the border of the valid area is not an edge.
+void ZeroInvalid(const ImageU8& valid, const Plane& dx, const Plane& dy, const Plane& g2) {
+  const std::size_t n = valid.NumPixels();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (valid.Data()[i] == 0) dx.data[i] = dy.data[i] = g2.data[i] = 0.0f;
+  }
+}
+
 }  // namespace
 
 void PyramidOptions::Check() const {
@@ -81,8 +89,12 @@ int NumPyramidLevels(int width, int height, const PyramidOptions& options) {
   return levels;
 }
 
-ImagePyramid::ImagePyramid(const ImageView<std::uint8_t>& image, const PyramidOptions& options) {
+ImagePyramid::ImagePyramid(const ImageView<std::uint8_t>& image, const PyramidOptions& options,
+                           const ValidityMask* validity) {
   CheckArgument(!image.Empty(), "ImagePyramid: the input image is empty");
+  CheckArgument(validity == nullptr || (validity->Level(0).Width() == image.Width() &&
+                                        validity->Level(0).Height() == image.Height()),
+                "ImagePyramid: the validity mask's size differs from the image's");
   const int num_levels = NumPyramidLevels(image.Width(), image.Height(), options);
   constexpr std::size_t kPlanes = 4;  // intensity, dx, dy, grad_sq
   std::vector<std::size_t> offsets;
@@ -105,10 +117,17 @@ ImagePyramid::ImagePyramid(const ImageView<std::uint8_t>& image, const PyramidOp
   ConvertToFloat(image, planes[0][0]);
   for (std::size_t l = 1; l < planes.size(); ++l) Downsample2x2(planes[l - 1][0], planes[l][0]);
   levels_.reserve(planes.size());
-  for (const auto& level : planes) {
+  const bool masked = validity != nullptr && !validity->AllValid();
+  for (std::size_t l = 0; l < planes.size(); ++l) {
+    const auto& level = planes[l];
     ComputeGradients(level[0], level[1], level[2], level[3]);
     const auto view = [](const Plane& p) { return ImageViewF(p.data, p.width, p.height); };
     levels_.push_back(PyramidLevel{view(level[0]), view(level[1]), view(level[2]), view(level[3])});
+    if (masked && static_cast<int>(l) < validity->NumLevels()) {
+      const ImageU8& valid = validity->Level(static_cast<int>(l));
+      ZeroInvalid(valid, level[1], level[2], level[3]);
+      levels_.back().valid = valid.Data();
+    }
   }
 }
 
@@ -135,6 +154,11 @@ ImageF MaxGradient3x3(const PyramidLevel& level) {
     const float* down = horizontal.Row(std::min(y + 1, h - 1));
     float* dst = out.Row(y);
     for (int x = 0; x < w; ++x) dst[x] = std::max({up[x], mid[x], down[x]});
+  }
+  if (level.valid != nullptr) {  // the maximum must not spread back into the border
+    for (std::size_t i = 0; i < out.NumPixels(); ++i) {
+      if (level.valid[i] == 0) out.Data()[i] = 0.0f;
+    }
   }
   return out;
 }

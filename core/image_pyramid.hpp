@@ -6,6 +6,7 @@
 
 #include "core/buffer_pool.hpp"
 #include "core/image.hpp"
+#include "core/validity_mask.hpp"
 
 namespace parallax {
 
@@ -28,6 +29,9 @@ struct PyramidLevel {
   ImageViewF dx;
   ImageViewF dy;
   ImageViewF grad_sq;  ///< dx^2 + dy^2
+  /// ValidityMask::Level of this level (row-major, this level's size): 0 where the pixel or
+  /// its stencils see no input, and dx, dy, grad_sq are 0 there. nullptr: all pixels valid.
+  const std::uint8_t* valid = nullptr;
 
   int Width() const { return intensity.Width(); }
   int Height() const { return intensity.Height(); }
@@ -42,8 +46,10 @@ struct PyramidLevel {
 /// than one per plane, and better locality). Move-only: levels view the owned buffer.
 class ImagePyramid {
  public:
-  /// Throws std::invalid_argument for an empty image or invalid options.
-  explicit ImagePyramid(const ImageView<std::uint8_t>& image, const PyramidOptions& options = {});
+  /// Throws std::invalid_argument for an empty image, invalid options or a `validity` whose
+  /// level 0 is not the image's size. `validity` (may be null) must outlive the pyramid.
+  explicit ImagePyramid(const ImageView<std::uint8_t>& image, const PyramidOptions& options = {},
+                        const ValidityMask* validity = nullptr);
   ImagePyramid(const ImagePyramid&) = delete;
   ImagePyramid& operator=(const ImagePyramid&) = delete;
   ImagePyramid(ImagePyramid&&) noexcept = default;
@@ -63,8 +69,8 @@ class ImagePyramid {
 int NumPyramidLevels(int width, int height, const PyramidOptions& options);
 
 /// Per pixel, the largest gradient magnitude |grad I| in its 3x3 neighbourhood (clamped at
-/// the image border). LSD-SLAM selects semi-dense pixels on this, so that thin edges
-/// contribute the pixels on both sides.
+/// the image border), 0 where the level's validity mask excludes the pixel. LSD-SLAM selects
+/// semi-dense pixels on this, so that thin edges contribute the pixels on both sides.
 ImageF MaxGradient3x3(const PyramidLevel& level);
 
 /// Row-major indices (y * width + x) of the pixels whose 3x3 max gradient is >= min_gradient,

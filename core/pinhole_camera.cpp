@@ -1,8 +1,10 @@
 #include "core/pinhole_camera.hpp"
 
 #include <cmath>
+#include <utility>
 
 #include "core/check.hpp"
+#include "core/validity_mask.hpp"
 
 namespace parallax {
 
@@ -37,6 +39,15 @@ PinholeCamera PinholeCamera::AtLevel(int level) const {
   const double scale = std::ldexp(1.0, -level);
   return PinholeCamera(std::max(1, width_ >> level), std::max(1, height_ >> level), fx_ * scale,
                        fy_ * scale, (cx_ + 0.5) * scale - 0.5, (cy_ + 0.5) * scale - 0.5);
+}
+
+PinholeCamera PinholeCamera::WithValidity(std::shared_ptr<const ValidityMask> mask) const {
+  CheckArgument(
+      mask == nullptr || (mask->Level(0).Width() == width_ && mask->Level(0).Height() == height_),
+      "PinholeCamera::WithValidity: the mask's size differs from the camera's");
+  PinholeCamera out = *this;
+  out.validity_ = std::move(mask);
+  return out;
 }
 
 std::string PinholeCamera::ToString() const {

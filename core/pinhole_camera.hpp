@@ -2,9 +2,12 @@
 // The ideal pinhole camera the engine works in (after undistortion).
 
 #include <Eigen/Core>
+#include <memory>
 #include <string>
 
 namespace parallax {
+
+class ValidityMask;
 
 /// Pinhole intrinsics of a width x height image: u = fx x/z + cx, v = fy y/z + cy, in pixels,
 /// with pixel (0,0) centred on the top-left pixel (docs/conventions.md).
@@ -43,6 +46,14 @@ class PinholeCamera {
 
   std::string ToString() const;
 
+  /// Which pixels see the scene (docs/calibration.md, "Validity mask"); nullptr: all of them.
+  /// Set by the Undistorter when its view has pixels no input reaches. AtLevel's cameras
+  /// have none: the mask of each level is ValidityMask::Level.
+  const std::shared_ptr<const ValidityMask>& Validity() const { return validity_; }
+  /// A copy that sees only the pixels of `mask` (level 0 must have this camera's size;
+  /// throws std::invalid_argument otherwise). nullptr removes the mask.
+  PinholeCamera WithValidity(std::shared_ptr<const ValidityMask> mask) const;
+
  private:
   int width_;
   int height_;
@@ -50,6 +61,7 @@ class PinholeCamera {
   double fy_;
   double cx_;
   double cy_;
+  std::shared_ptr<const ValidityMask> validity_;
 };
 
 }  // namespace parallax

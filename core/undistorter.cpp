@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "core/check.hpp"
+#include "core/validity_mask.hpp"
 
 namespace parallax {
 
@@ -148,6 +150,7 @@ Undistorter::Undistorter(const Camera& input, const UndistorterOptions& options)
               output_.Fy() == K_in.Fy() && output_.Cx() == K_in.Cx() && output_.Cy() == K_in.Cy();
   maps_->map_x.create(output_.Height(), output_.Width(), CV_32FC1);
   maps_->map_y.create(output_.Height(), output_.Width(), CV_32FC1);
+  ImageU8 seen(output_.Width(), output_.Height());
   for (int y = 0; y < output_.Height(); ++y) {
     auto* mx = maps_->map_x.ptr<float>(y);
     auto* my = maps_->map_y.ptr<float>(y);
@@ -157,8 +160,12 @@ Undistorter::Undistorter(const Camera& input, const UndistorterOptions& options)
                          uv->y() < input.Height() - 0.5;
       mx[x] = valid ? static_cast<float>(uv->x()) : -1.0f;
       my[x] = valid ? static_cast<float>(uv->y()) : -1.0f;
+      seen(x, y) = valid ? 1 : 0;
     }
   }
+  // Pixels no input reaches (a `full` view's border) must not become texture downstream.
+  auto validity = std::make_shared<const ValidityMask>(seen);
+  if (!validity->AllValid()) output_ = output_.WithValidity(std::move(validity));
   cv::convertMaps(maps_->map_x, maps_->map_y, maps_->fixed_xy, maps_->fixed_frac, CV_16SC2);
 }
 

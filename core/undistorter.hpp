@@ -42,6 +42,8 @@ class Undistorter {
   Undistorter(Undistorter&&) noexcept;
   Undistorter& operator=(Undistorter&&) noexcept;
 
+  /// The pinhole camera of the output images; it carries a ValidityMask when some output
+  /// pixels have no input (kFull, kExplicit views wider than the lens), nothing otherwise.
   const PinholeCamera& OutputCamera() const { return output_; }
   const Camera& InputCamera() const { return input_; }
   /// True when the input is already the output pinhole camera: Apply is then a copy.

@@ -137,6 +137,12 @@ StereoObservation EpipolarSearch::Observe(int x, int y, float min_idepth, float 
   std::array<float, kMaxSamples> samples;  // NOLINT(cppcoreguidelines-pro-type-member-init)
   for (int j = 0; j < num_samples; ++j) {
     const Eigen::Vector2f p = far + (s0 + static_cast<float>(j - kPatternHalf)) * dir;
+    // A window that reaches where the frame sees no input is cut as by the image border.
+    if (frame_.valid != nullptr &&
+        frame_.valid[static_cast<int>(p.y()) * frame_.Width() + static_cast<int>(p.x())] == 0) {
+      out.status = StereoStatus::kOutOfImage;
+      return out;
+    }
     samples[Idx(j)] = InterpolateBilinear(frame_.intensity, p.x(), p.y());
   }
   const int num_positions = num_samples - 2 * kPatternHalf;

@@ -34,8 +34,8 @@ struct PhotometricTerm {
 
 /// Warps the reference point (ray / idepth) with p = M ray / idepth + t (M = R for SE(3),
 /// s R for Sim(3)) and evaluates the photometric residual. Returns false when p is behind the
-/// camera or x' is not inside [1, w-2] x [1, h-2] (where gradients and bilinear lookups are
-/// valid). Inlined: this is the hot loop.
+/// camera, x' is not inside [1, w-2] x [1, h-2] (where gradients and bilinear lookups are
+/// valid) or the frame's validity mask excludes it. Inlined: this is the hot loop.
 inline bool EvaluatePhotometric(const PyramidLevel& frame, const LevelCamera& camera,
                                 const Eigen::Matrix3f& M, const Eigen::Vector3f& t, float ray_x,
                                 float ray_y, float idepth, float idepth_variance,
@@ -48,6 +48,11 @@ inline bool EvaluatePhotometric(const PyramidLevel& frame, const LevelCamera& ca
   const float xn = p_scaled.x() * inv_z, yn = p_scaled.y() * inv_z;
   const float u = camera.fx * xn + camera.cx, v = camera.fy * yn + camera.cy;
   if (!(u >= 1.0f && v >= 1.0f && u < camera.max_u && v < camera.max_v)) {
+    return false;
+  }
+  // Where the frame sees no input (validity mask), as outside the image.
+  if (frame.valid != nullptr &&
+      frame.valid[static_cast<int>(v) * frame.Width() + static_cast<int>(u)] == 0) {
     return false;
   }
   const float I = InterpolateBilinear(frame.intensity, u, v);

@@ -6,6 +6,8 @@
 
 #include <cmath>
 
+#include "core/validity_mask.hpp"
+
 namespace parallax {
 namespace {
 
@@ -89,6 +91,30 @@ TEST(Undistorter, FullModeKeepsWholeInputInView) {
   // Full mode sees more than crop mode: smaller focal length.
   const Undistorter crop(camera, UndistorterOptions{});
   EXPECT_LT(K.Fx(), crop.OutputCamera().Fx());
+}
+
+TEST(Undistorter, FullModeMarksThePixelsNoInputReaches) {
+  UndistorterOptions options;
+  options.mode = UndistortMode::kFull;
+  const Undistorter full(Fr1RadTan(), options);
+  ASSERT_NE(full.OutputCamera().Validity(), nullptr);
+  const ImageU8& valid = full.OutputCamera().Validity()->Level(0);
+  const ImageU8 image = full.Apply(RenderDistorted(Fr1RadTan()));
+  int black_border = 0;
+  for (int v = 0; v < valid.Height(); ++v) {
+    for (int u = 0; u < valid.Width(); ++u) {
+      const bool no_input = full.SourceOf(u, v) == Eigen::Vector2f(-1.0f, -1.0f);
+      if (no_input) {
+        EXPECT_EQ(valid(u, v), 0) << u << "," << v;  // never valid
+      }
+      black_border += no_input && image(u, v) == 0;
+    }
+  }
+  EXPECT_GT(black_border, 1000);  // the test is about something: there is a black border
+  EXPECT_LT(full.OutputCamera().Validity()->ValidFraction(), 0.99);
+  EXPECT_GT(full.OutputCamera().Validity()->ValidFraction(), 0.5);
+  // Crop mode sees input everywhere: no mask.
+  EXPECT_EQ(Undistorter(Fr1RadTan(), UndistorterOptions{}).OutputCamera().Validity(), nullptr);
 }
 
 TEST(Undistorter, ExplicitModeUsesGivenIntrinsics) {

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "core/validity_mask.hpp"
 #include "tests/tracking/render_fixture.hpp"
 
 namespace parallax {
@@ -137,6 +138,39 @@ TEST_F(EpipolarSearchTest, WindowCutByTheBorderIsOutOfImage) {
   EXPECT_EQ(left_ok, 0);
   EXPECT_GT(inside_ok, inside_tried / 10);
   EXPECT_GT(inside_right, 0.9 * inside_ok);
+}
+
+// Where the frame sees no input (a `full` rectification's border, here its left 200 columns)
+// the search stops as at the image border: no match is made there, and none elsewhere is lost.
+TEST_F(EpipolarSearchTest, NoMatchWhereTheFrameSeesNoInput) {
+  const Eigen::Vector3d t(0.05, 0.0, 0.0);
+  ImageU8 seen(640, 480, 1);
+  for (int y = 0; y < 480; ++y) std::fill_n(seen.Row(y), 200, std::uint8_t{0});
+  const PinholeCamera masked =
+      test::TestCamera().WithValidity(std::make_shared<const ValidityMask>(seen));
+  const Frame frame(1, 0.0, masked, test::RenderTestImage(*scene_, T_w_kf_ * SE3d(SO3d(), t)));
+  const DepthFilterOptions options;
+  const EpipolarSearch search(*keyframe_->frame, {&frame, SE3d(SO3d(), t).Inverse()}, options);
+  const double fx = keyframe_->frame->Camera(0).Fx();
+  int border_ok = 0, border_tried = 0, inside_ok = 0;
+  const ImageF& truth = keyframe_->idepth;
+  for (int y = 8; y < truth.Height() - 8; y += 3) {
+    for (int x = 8; x < truth.Width() - 8; x += 3) {
+      const float d = truth(x, y);
+      if (!(d > 0.0f)) continue;
+      const StereoObservation obs = search.Observe(x, y, 0.8f * d, 1.2f * d, d, 30.0f);
+      const double match_x = x - fx * t.x() * d;
+      if (match_x < 195.0) {
+        ++border_tried;
+        border_ok += obs.status == StereoStatus::kOk;
+      } else if (match_x > 230.0) {
+        inside_ok += obs.status == StereoStatus::kOk;
+      }
+    }
+  }
+  EXPECT_GT(border_tried, 1000);
+  EXPECT_EQ(border_ok, 0);
+  EXPECT_GT(inside_ok, 1000);
 }
 
 // The baseline's uncertainty enters as d^2 (baseline_sigma / |t|)^2: the same match, with a

@@ -110,6 +110,23 @@ TEST_P(PhotometricJacobianTest, MatchesNumericDifferentiation) {
 
 INSTANTIATE_TEST_SUITE_P(RampAndQuadratic, PhotometricJacobianTest, ::testing::Values(0.0, 2e-4));
 
+TEST(PhotometricKernel, APointWhereTheFrameSeesNoInputIsOutsideIt) {
+  AnalyticLevel image(0.0);
+  const LevelCamera cam{525.0f, 525.0f, 319.5f, 239.5f, 638.0f, 478.0f};
+  const KernelInput in = WithPose(KernelInput{}, SE3d());
+  PhotometricTerm term;
+  ASSERT_TRUE(EvaluatePhotometric(image.level, cam, in.M, in.t, in.ray_x, in.ray_y, in.idepth, 0.0f,
+                                  in.intensity, in.gain, in.offset, 16.0f, &term));
+  // The point lands at (345.75, 197.5): its pixel masked out, it is not evaluated.
+  ImageU8 valid(640, 480, 1);
+  image.level.valid = valid.Data();
+  EXPECT_TRUE(EvaluatePhotometric(image.level, cam, in.M, in.t, in.ray_x, in.ray_y, in.idepth, 0.0f,
+                                  in.intensity, in.gain, in.offset, 16.0f, &term));
+  valid(345, 197) = 0;
+  EXPECT_FALSE(EvaluatePhotometric(image.level, cam, in.M, in.t, in.ray_x, in.ray_y, in.idepth,
+                                   0.0f, in.intensity, in.gain, in.offset, 16.0f, &term));
+}
+
 // --- Convergence on renders ------------------------------------------------------------
 
 class Se3TrackerRenderTest : public ::testing::Test {
