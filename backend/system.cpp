@@ -37,6 +37,8 @@ void SystemOptions::Check() const {
   CheckOption(auto_pair_residual_ratio > 0.0, "SystemOptions", "auto_pair_residual_ratio",
               "must be > 0");
   CheckOption(restart_after_lost >= 1, "SystemOptions", "restart_after_lost", "must be >= 1");
+  CheckOption(max_start_exposure_change > 1.0 && std::isfinite(max_start_exposure_change),
+              "SystemOptions", "max_start_exposure_change", "must be > 1 and finite");
   CheckOption(keyframe_distance > 0.0, "SystemOptions", "keyframe_distance", "must be > 0");
   CheckOption(min_keyframe_usage >= 0.0 && min_keyframe_usage <= 1.0, "SystemOptions",
               "min_keyframe_usage", "must be in [0, 1]");

@@ -94,6 +94,11 @@ struct SystemOptions {
   /// Auto and random: start again from the current frame after this many frames lost in a row
   /// before initialisation completed.
   int restart_after_lost = 10;
+  /// ... and at once when a frame's brightness differs from the first keyframe's by more
+  /// than this factor (tracking's gain estimate): the exposure is still settling, as after a
+  /// very dark start, and the start keyframe would soon be beyond tracking's brightness
+  /// range (docs/reliability.md, "Hard input").
+  double max_start_exposure_change = 2.0;
   /// Frames without usable structure (blank, dark, blown out, noise) are reported lost
   /// before tracking: they would otherwise be "tracked" into a garbage pose.
   FrameQualityOptions quality;
@@ -454,6 +459,8 @@ class System {
   BufferedPoses KeepTheBetterStart(const std::shared_ptr<const Frame>& pair_frame,
                                    const TwoViewPair& pair);
   FrameResult ProcessTwoViewOnly(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
+  /// Abandons the start (its poses withdrawn) and starts again on `frame`.
+  FrameResult RestartStart(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
   std::optional<FrameResult> ProcessWhileInitialising(const std::shared_ptr<const Frame>& frame,
                                                       const ImageU8& image,
                                                       const TrackingResult& tracked);

@@ -143,6 +143,13 @@ FrameResult System::ProcessTwoViewOnly(const std::shared_ptr<const Frame>& frame
 std::optional<FrameResult> System::ProcessWhileInitialising(
     const std::shared_ptr<const Frame>& frame, const ImageU8& image,
     const TrackingResult& tracked) {
+  // The exposure is still settling (an auto-exposure after a dark start): the first
+  // keyframe no longer looks like the scene, and the tracker's brightness range will soon be
+  // exceeded. Start again on this frame.
+  if (tracked.status != TrackingStatus::kLost &&
+      std::abs(tracked.affine.a) > std::log(options_.max_start_exposure_change)) {
+    return RestartStart(frame, image);
+  }
   if (start_ == StartState::kRandomPairSearch) {
     if (const auto pair = bootstrap_->TryFrame(image)) {
       pending_pair_.emplace(frame, *pair);
@@ -169,21 +176,30 @@ std::optional<FrameResult> System::ProcessWhileInitialising(
   }
   if (tracked.status == TrackingStatus::kPoor) return std::nullopt;
   result.status = TrackingStatus::kLost;
-  // Lost frames wait for a pair while one is sought; then a restart is the way out.
-  if (start_ == StartState::kRandomPairSearch || ++lost_in_a_row_ < options_.restart_after_lost) {
+  // Lost frames wait (a pair may still be found for them); after restart_after_lost in a row
+  // a restart is the way out, also while a pair is sought: a start on a bad first frame
+  // otherwise stays lost for as long as the pair search lasts.
+  if (++lost_in_a_row_ < options_.restart_after_lost) {
     BufferInitialFrame(frame, tracker_.State().T_kf_last);  // tried again when initialised
     return result;
   }
+  return RestartStart(frame, image);
+}
+
+FrameResult System::RestartStart(const std::shared_ptr<const Frame>& frame, const ImageU8& image) {
   // The start has failed: withdraw every pose given so far and start again here.
-  result.revised.push_back(Revised(*mapper_.Map().KeyframePtr(), std::nullopt));
+  std::vector<RevisedPose> withdrawn;
+  withdrawn.push_back(Revised(*mapper_.Map().KeyframePtr(), std::nullopt));
   for (const auto& buffered : initial_frames_) {
-    result.revised.push_back(Revised(*buffered.first, std::nullopt));
+    withdrawn.push_back(Revised(*buffered.first, std::nullopt));
   }
   initial_frames_.clear();
+  bootstrap_.reset();
+  pending_pair_.reset();
   ClearMap();
   start_ = StartState::kNoKeyframe;
   FrameResult restarted = StartFirstKeyframe(frame, image);
-  restarted.revised = std::move(result.revised);
+  restarted.revised = std::move(withdrawn);
   restarted.events.insert(restarted.events.begin(),
                           {SystemEvent::Kind::kRestarted, frame->Id(), frame->Id()});
   return restarted;

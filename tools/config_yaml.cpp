@@ -65,6 +65,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"auto_max_direction_deg", Set(&o->auto_max_direction_deg)},
         {"auto_pair_residual_ratio", Set(&o->auto_pair_residual_ratio)},
         {"restart_after_lost", Set(&o->restart_after_lost)},
+        {"max_start_exposure_change", Set(&o->max_start_exposure_change)},
         {"min_start_texture", Set(&o->min_start_texture)},
         {"bootstrap_max_frames", Set(&o->bootstrap_max_frames)},
         {"bootstrap_min_parallax_deg", Set(&o->bootstrap.min_parallax_deg)},
