@@ -56,7 +56,8 @@ ImageU8 BorderedTexture(ImageU8* valid) {
     for (int x = 0; x < 64; ++x) {
       const bool seen = x >= 20;
       (*valid)(x, y) = seen ? 1 : 0;
-      image(x, y) = seen ? static_cast<std::uint8_t>(100 + 40 * (((x / 6) + (y / 6)) % 2)) : 0;
+      image(x, y) =
+          seen ? static_cast<std::uint8_t>(100 + 40 * (((x / 6) + (y / 6)) % 2)) : std::uint8_t{0};
     }
   }
   return image;
@@ -97,7 +98,7 @@ TEST(ValidityMask, NoiseInsideABlackBorderIsStillNoise) {
     for (int x = 0; x < 160; ++x) {
       const bool seen = (x - 80) * (x - 80) + (y - 60) * (y - 60) < 55 * 55;
       valid(x, y) = seen ? 1 : 0;
-      image(x, y) = seen ? static_cast<std::uint8_t>(grey(rng)) : 0;
+      image(x, y) = seen ? static_cast<std::uint8_t>(grey(rng)) : std::uint8_t{0};
     }
   }
   const ValidityMask mask(valid, 2);
