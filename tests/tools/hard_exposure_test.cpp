@@ -22,8 +22,9 @@
 namespace parallax {
 namespace {
 
-const std::string kClip =
-    std::string(PARALLAX_SHARED_DATA_DIR) + "/rgbd_dataset_freiburg1_xyz_first37";
+std::string ClipFolder() {
+  return std::string(PARALLAX_SHARED_DATA_DIR) + "/rgbd_dataset_freiburg1_xyz_first37";
+}
 
 // Gain of frame k of n: the first `dark` frames rise from 3% exposure by 40% a frame, the last
 // `bright` frames rise by 35% a frame from 1.35x (clipped at 255).
@@ -35,8 +36,8 @@ double Gain(int k, int n, int dark, int bright) {
 
 // A copy of the clip with exposure applied to the images (sensor noise sigma 1.5 added).
 std::vector<std::string> WriteExposedCopy(const std::string& out, int dark, int bright) {
-  std::filesystem::copy(kClip, out, std::filesystem::copy_options::recursive);
-  std::ifstream list(kClip + "/rgb.txt");
+  std::filesystem::copy(ClipFolder(), out, std::filesystem::copy_options::recursive);
+  std::ifstream list(ClipFolder() + "/rgb.txt");
   std::vector<std::string> files;
   for (std::string line; std::getline(list, line);) {
     if (line.empty() || line[0] == '#') continue;
@@ -50,7 +51,7 @@ std::vector<std::string> WriteExposedCopy(const std::string& out, int dark, int 
   const int n = static_cast<int>(files.size());
   for (int k = 0; k < n; ++k) {
     cv::Mat image =
-        cv::imread(kClip + "/" + files[static_cast<std::size_t>(k)], cv::IMREAD_GRAYSCALE);
+        cv::imread(ClipFolder() + "/" + files[static_cast<std::size_t>(k)], cv::IMREAD_GRAYSCALE);
     const double gain = Gain(k, n, dark, bright);
     for (int y = 0; y < image.rows; ++y) {
       for (int x = 0; x < image.cols; ++x) {
