@@ -10,6 +10,7 @@
 
 #include "tests/tools/temp_dir.hpp"
 #include "tools/dataset/calibration_yaml.hpp"
+#include "tools/dataset/file_list_reader.hpp"
 #include "tools/dataset/input_error.hpp"
 
 namespace parallax {
@@ -279,6 +280,33 @@ TEST(VideoReader, ReadsFramesWithCalibration) {
     ++count;
   }
   EXPECT_EQ(count, 5);
+}
+
+}  // namespace
+}  // namespace parallax
+
+namespace parallax {
+namespace {
+
+// fuzz_image: a file that starts like a PGM but carries DICOM's "DICM" at byte 128 went to
+// OpenCV's GDCM decoder, which allocated 3.8 GB. It is refused before any decoder sees it.
+TEST(ReadGreyImage, ADicomFileIsRefusedWhateverItsFirstBytes) {
+  const test::TempDir dir;
+  std::string bytes = "P2\n2 2\n255\n1 2 3 4\n";
+  bytes.resize(128, ' ');
+  bytes += "DICM";
+  bytes.resize(160, '\0');
+  const std::string path = dir.Write("frame.pgm", bytes);
+  try {
+    ReadGreyImage(path);
+    FAIL() << "a DICOM file was decoded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("DICOM"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+  // The same PGM without the DICOM signature is read.
+  const std::string plain = dir.Write("plain.pgm", "P2\n2 2\n255\n1 2 3 4\n");
+  EXPECT_EQ(ReadGreyImage(plain).Width(), 2);
 }
 
 }  // namespace

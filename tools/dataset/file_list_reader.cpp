@@ -25,13 +25,20 @@ void CheckTimestampsIncrease(const std::vector<ImageEntry>& entries) {
 namespace {
 
 /// OpenCV picks a decoder by the file's content and links many (DICOM, JPEG 2000, OpenEXR,
-/// ...); some abort the process on malformed input (fuzz_image found GDCM asserting). Only
-/// the formats image sequences come in reach a decoder.
+/// ...); some abort the process or exhaust memory on malformed input (fuzz_image found GDCM
+/// asserting, and allocating 3.8 GB). Only the formats image sequences come in reach a
+/// decoder.
 void CheckImageSignature(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  unsigned char b[12] = {};
+  unsigned char b[132] = {};
   in.read(reinterpret_cast<char*>(b), sizeof(b));
   const auto n = static_cast<std::size_t>(in.gcount());
+  // DICOM's signature is "DICM" after a 128-byte preamble, which may start like any format
+  // above; OpenCV then hands the file to GDCM whatever its first bytes (fuzz_image: a "P2"
+  // file with DICM at 128 made GDCM allocate 3.8 GB).
+  if (n >= 132 && b[128] == 'D' && b[129] == 'I' && b[130] == 'C' && b[131] == 'M') {
+    throw InputError(path, "a DICOM file, not an image sequence's frame");
+  }
   const auto starts = [&](std::initializer_list<unsigned char> sig) {
     return n >= sig.size() && std::equal(sig.begin(), sig.end(), b);
   };
