@@ -54,9 +54,8 @@ std::vector<SystemEvent> System::FinishMapping() {
   }
   {
     const std::lock_guard<std::mutex> engine(engine_mutex_);
-    // A keyframe is finished again only when it was (a relocalisation's target): its image
-    // is in the place database and its edges exist, so nothing repeats.
-    // After StopMapping the backend is gone: the map stays as it was stopped.
+    // Finishing it again later (frames given after this) repeats nothing: its image is in
+    // the place database and its edges exist. After StopMapping the backend is gone.
     if (start_ == StartState::kInitialised && !mapping_stopped_) FinishCurrentKeyframe(&last);
   }
   if (worker_) backend_worker_->Drain();
