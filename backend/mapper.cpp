@@ -39,16 +39,18 @@ void Mapper::PublishReference() {
                                                          reference_options_);
 }
 
-void Mapper::Update(const Frame& frame, const SE3d& T_kf_update, const TrackingResult& tracked) {
+DepthUpdateStats Mapper::Update(const Frame& frame, const SE3d& T_kf_update,
+                                const TrackingResult& tracked) {
   const StereoFrame stereo{&frame, T_kf_update.Inverse(), tracked.affine.Gain(), tracked.affine.b,
                            static_cast<float>(1.0 - tracked.stats.good_ratio)};
-  depth_filter_.Update(map_.get(), stereo);
+  return depth_filter_.Update(map_.get(), stereo);
 }
 
 std::pair<InverseDepthMap, float> Mapper::Propagate(const std::shared_ptr<const Frame>& frame,
-                                                    const TrackingResult& tracked) const {
+                                                    const TrackingResult& tracked,
+                                                    PropagationStats* stats) const {
   InverseDepthMap next = depth_filter_.Propagate(*map_, frame, tracked.T_kf_frame.Inverse(),
-                                                 tracked.affine.Gain(), tracked.affine.b);
+                                                 tracked.affine.Gain(), tracked.affine.b, stats);
   const float s = depth_filter_.NormalizeScale(&next);
   return {std::move(next), s};
 }

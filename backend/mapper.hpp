@@ -42,11 +42,14 @@ class Mapper {
   /// Publishes the current map's reference again (after depth changed).
   void PublishReference();
   /// One stereo update of the current map from a tracked frame seen at T_kf_update.
-  void Update(const Frame& frame, const SE3d& T_kf_update, const TrackingResult& tracked);
+  DepthUpdateStats Update(const Frame& frame, const SE3d& T_kf_update,
+                          const TrackingResult& tracked);
   /// The depth of a new keyframe at `frame` (propagated and scale-normalised) and the scale s
-  /// the normalisation multiplied inverse depths by.
+  /// the normalisation multiplied inverse depths by. Throws NumericalDivergence when the
+  /// propagated map diverged (its mean inverse depth is not finite).
   std::pair<InverseDepthMap, float> Propagate(const std::shared_ptr<const Frame>& frame,
-                                              const TrackingResult& tracked) const;
+                                              const TrackingResult& tracked,
+                                              PropagationStats* stats = nullptr) const;
   /// The current keyframe as the graph keeps it (frozen sparse depth, image, reference).
   std::shared_ptr<Keyframe> Freeze() const;
   /// The current map becomes the newest recent one (the oldest beyond the limit is dropped);

@@ -8,6 +8,7 @@
 #include "backend/live_tracker.hpp"
 #include "backend/mapping_worker.hpp"
 #include "core/check.hpp"
+#include "core/divergence.hpp"
 #include "core/stopwatch.hpp"
 
 namespace parallax {
@@ -96,101 +97,6 @@ RevisedPose System::Revised(const Frame& frame, const std::optional<SE3d>& T_kf_
     pose.T_w_c = (CurrentKeyframePose() * Sim3d(*T_kf_frame)).RigidPart();
   }
   return pose;
-}
-
-void System::FinishCurrentKeyframe(FrameResult* result) {
-  if (!mapper_.HasMap()) return;  // a loaded map before its first relocalisation
-  const std::shared_ptr<Keyframe> keyframe = mapper_.Freeze();
-  const bool is_new = !graph_.Contains(keyframe->id);
-  graph_.Upsert(keyframe, CurrentKeyframePose(), current_map_);
-  result->events.push_back({SystemEvent::Kind::kKeyframeFinished, result_frame_id_, keyframe->id});
-  if (!options_.optimize_graph) {
-    if (is_new && current_.parent) {
-      graph_.AddEdge(PoseGraphEdge{*current_.parent, keyframe->id, current_.S_parent_kf,
-                                   Matrix7d::Identity(), EdgeKind::kOdometry});
-    }
-    return;
-  }
-  FinishedKeyframe finished{keyframe->id, is_new ? current_.parent : std::nullopt,
-                            current_.S_parent_kf};
-  // Real-time mode: the backend thread takes it (RunBackendBatch).
-  if (backend_worker_) {
-    backend_pending_.push_back(finished);
-    backend_worker_->Notify();
-    return;
-  }
-  RunBackend(finished, result);
-}
-
-void System::RunBackend(const FinishedKeyframe& finished, FrameResult* result) {
-  RunBackendOn(&graph_, finished, result_frame_id_, &backend_stats_, &result->events);
-  chain_information_ = backend_.FallbackInformation();
-  FollowMerges(result->events);
-}
-
-void System::RunBackendOn(KeyframeGraph* graph, const FinishedKeyframe& finished,
-                          std::int64_t frame_id, BackendStats* stats,
-                          std::vector<SystemEvent>* events) {
-  const auto start = Clock::now();
-  const BackendReport report =
-      backend_.KeyframeFinished(graph, finished.id, finished.parent, finished.S_parent_kf);
-  stats->alignments += report.alignments;
-  stats->edges_rejected += report.edges_rejected;
-  if (report.optimisation) {
-    CountOptimisation(*report.optimisation, stats);
-    stats->optimisation_ms.push_back(MillisecondsSince(start));
-    events->push_back({SystemEvent::Kind::kGraphOptimised, frame_id, finished.id});
-  }
-  RecognisePlace(graph, finished.id, frame_id, stats, events);
-}
-
-void System::CountOptimisation(const PoseGraphSummary& summary, BackendStats* stats) {
-  ++stats->optimisations;
-  stats->iterations += summary.iterations;
-}
-
-void System::RecognisePlace(KeyframeGraph* graph, std::int64_t id, std::int64_t frame_id,
-                            BackendStats* stats, std::vector<SystemEvent>* events) {
-  if (!options_.loop_closure.enabled && !options_.relocalization.enabled) return;
-  {
-    const std::shared_lock<std::shared_mutex> place(place_mutex_);
-    if (place_.Contains(id)) return;  // refined again: its image did not change
-  }
-  const auto start = Clock::now();
-  auto entry = place_.Describe(graph->Get(id).image);
-  {
-    const std::unique_lock<std::shared_mutex> place(place_mutex_);
-    place_.Add(id, std::move(entry));
-  }
-  LoopReport loop;
-  {
-    const std::shared_lock<std::shared_mutex> place(place_mutex_);
-    loop = loop_closer_.KeyframeFinished(graph, &backend_, id);
-  }
-  stats->loop_candidates += loop.candidates;
-  stats->loop_checks += loop.consistent;
-  stats->loops_rejected += loop.rejected;
-  if (loop.optimisation) CountOptimisation(*loop.optimisation, stats);
-  stats->loop_ms.push_back(MillisecondsSince(start));
-  if (loop.merged_map) {
-    ++stats->merges;
-    SystemEvent merged{SystemEvent::Kind::kMapsMerged, frame_id, id, *loop.loop_keyframe};
-    merged.map_id = *loop.merged_map;
-    events->push_back(merged);
-  }
-  if (loop.loop_keyframe) {
-    ++stats->loops_closed;
-    events->push_back({SystemEvent::Kind::kLoopClosed, frame_id, id, *loop.loop_keyframe});
-    events->push_back({SystemEvent::Kind::kGraphOptimised, frame_id, id});
-  }
-}
-
-void System::FollowMerges(const std::vector<SystemEvent>& events) {
-  for (const SystemEvent& e : events) {
-    if (e.kind == SystemEvent::Kind::kMapsMerged && current_map_ == e.map_id) {
-      current_map_ = graph_.MapOf(e.keyframe_id);
-    }
-  }
 }
 
 void System::StartKeyframe(const std::shared_ptr<const Frame>& frame, const Sim3d& S_w_kf,
@@ -323,7 +229,17 @@ FrameResult System::Process(const std::shared_ptr<const Frame>& frame, const Ima
 
 TrackingResult System::TrackFrame(const Frame& frame, FrameResult* result) {
   const auto start = Clock::now();
-  TrackingResult tracked = tracker_.Track(*mapper_.Reference(), frame);
+  TrackingResult tracked;
+  try {
+    tracked = tracker_.Track(*mapper_.Reference(), frame);
+  } catch (const NumericalDivergence& e) {
+    // The tracker's state changes only after a result: it is as before this frame.
+    tracked = TrackingResult{};
+    tracked.stats.diverged = true;
+    tracked.stats.reason = std::string("tracking diverged: ") + e.what();
+    ++backend_stats_.frames_diverged;
+    result->events.push_back({SystemEvent::Kind::kDiverged, frame.Id(), current_.id});
+  }
   result->tracking_ms = MillisecondsSince(start);
   result->status = tracked.status;
   result->stats = tracked.stats;
@@ -354,7 +270,8 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& 
         !initialised ? tracked.T_kf_frame
                      : mapper_.Direction().Refine(mapper_.KeyframeId(), image, tracked.T_kf_frame,
                                                   relative_distance);
-    mapper_.Update(*frame, T_kf_update, tracked);
+    backend_stats_.depth_estimates_diverged +=
+        mapper_.Update(*frame, T_kf_update, tracked).diverged;
     ++depth_updates_;
     if (!want_keyframe) mapper_.PublishReference();
   }
@@ -365,115 +282,37 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& 
       result->revised = FinishInitialisation();
     }
   }
-  if (want_keyframe) {  // ok or poor: a degrading view is the reason to switch
-    auto [next, s] = mapper_.Propagate(frame, tracked);
-    // Normalising multiplies idepth by s, so a point's new-keyframe coordinates become
-    // p' = p / s; the keyframe-to-world similarity absorbs it: S_w_new = S_w_c * Sim3(s).
-    const Sim3d S_w_c = CurrentKeyframePose() * Sim3d(tracked.T_kf_frame);
-    const SE3d& last_motion = tracker_.State().T_prev_last;
-    const SE3d velocity(last_motion.Rotation(), last_motion.Translation() / s);
-    StartKeyframe(frame, S_w_c * Sim3d(s, SO3d(), Eigen::Vector3d::Zero()), std::move(next),
-                  result);
-    SetPose(result, SE3d());  // the frame is the new keyframe
-    mapper_.Direction().SetKeyframe(frame->Id(), image);
-    // Constant-velocity guess for the next frame in the new keyframe's units.
-    tracker_.SetState(MotionState{SE3d(), velocity, AffineBrightness{}, 0});
-    result->is_keyframe = true;
-  }
+  // ok or poor: a degrading view is the reason to switch
+  if (want_keyframe) SwitchKeyframe(frame, image, tracked, result);
   result->mapping_ms = MillisecondsSince(start);
 }
 
-std::optional<TrackingResult> System::TrackRecentKeyframes(const Frame& frame,
-                                                           FrameResult* result) {
-  std::vector<RecoveryCandidate> candidates;
-  for (std::size_t i = 0; i < mapper_.NumRecent(); ++i) {
-    candidates.push_back({&mapper_.RecentReference(i), graph_.Pose(mapper_.RecentKeyframeId(i))});
+void System::SwitchKeyframe(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
+                            const TrackingResult& tracked, FrameResult* result) {
+  std::optional<std::pair<InverseDepthMap, float>> propagated;
+  try {
+    PropagationStats stats;
+    propagated = mapper_.Propagate(frame, tracked, &stats);
+    backend_stats_.depth_estimates_diverged += stats.diverged;
+  } catch (const NumericalDivergence&) {
+    // The propagated map diverged: no keyframe from it. The frame keeps its tracked pose and
+    // the current keyframe stays; the next frame that wants a keyframe tries again.
+    ++backend_stats_.keyframes_diverged;
+    result->events.push_back({SystemEvent::Kind::kDiverged, frame->Id(), current_.id});
+    return;
   }
-  const Sim3d S_w_last = CurrentKeyframePose() * Sim3d(tracker_.State().T_kf_last);
-  auto found = tracker_.Recover(candidates, frame, S_w_last);
-  if (!found) return std::nullopt;
-  // The found keyframe becomes current again (its depth is refined further and frozen again
-  // when it is left); the current one is finished and takes its place among the recent ones.
-  const std::int64_t id = mapper_.RecentKeyframeId(found->first);
-  FinishCurrentKeyframe(result);
-  mapper_.ReturnTo(found->first);
-  current_ = CurrentKeyframe{id, std::nullopt, Sim3d()};
-  CompactOldKeyframes();
-  return std::move(found->second);
-}
-
-std::optional<std::pair<std::shared_ptr<const Keyframe>, TrackingResult>> System::Relocalise(
-    const Frame& frame, const ImageU8& image) {
-  std::vector<RelocalizationGuess> guesses;
-  {
-    const std::shared_lock<std::shared_mutex> place(place_mutex_);
-    if (!options_.relocalization.enabled || place_.Size() == 0) return std::nullopt;
-    guesses = relocalizer_.Propose(graph_, place_, *place_.Describe(image));
-  }
-  ++backend_stats_.relocalisation_attempts;
-  for (const RelocalizationGuess& guess : guesses) {
-    const auto keyframe = Materialize(graph_.GetPtr(guess.keyframe_id), camera_, options_.pyramid,
-                                      options_.reference);
-    TrackingResult r =
-        tracker_.TrackFrom(*keyframe->reference, frame, guess.T_kf_frame, AffineBrightness{});
-    if (r.status != TrackingStatus::kOk) continue;
-    ++backend_stats_.relocalisations;
-    return std::make_pair(keyframe, std::move(r));
-  }
-  return std::nullopt;
-}
-
-void System::ReturnToKeyframe(const std::shared_ptr<const Keyframe>& keyframe,
-                              FrameResult* result) {
-  if (keyframe->id == current_.id) return;
-  FinishCurrentKeyframe(result);
-  std::optional<std::size_t> recent;
-  for (std::size_t i = 0; i < mapper_.NumRecent(); ++i) {
-    if (mapper_.RecentKeyframeId(i) == keyframe->id) recent = i;
-  }
-  if (recent) {
-    mapper_.ReturnTo(*recent);
-  } else {
-    // Its map again from the frozen depth; hypotheses stay unconfirmed.
-    InverseDepthMap map(keyframe->frame, options_.depth);
-    ImageF idepth, variance;
-    keyframe->depth.ToImages(&idepth, &variance);
-    map.InitializeFromPrior(idepth, variance);
-    for (std::size_t k = 0; k < keyframe->depth.Size(); ++k) {
-      if (!keyframe->depth.confirmed[k]) {
-        map.observations[static_cast<std::size_t>(keyframe->depth.pixel[k])] = 0;
-      }
-    }
-    if (mapper_.HasMap()) mapper_.Retire();
-    mapper_.SetMap(std::move(map));
-    mapper_.Direction().Reset();
-  }
-  current_ = CurrentKeyframe{keyframe->id, std::nullopt, Sim3d()};
-  current_map_ = graph_.MapOf(keyframe->id);
-  CompactOldKeyframes();
-}
-
-FrameResult System::StartNewMap(const std::shared_ptr<const Frame>& frame, const ImageU8& image) {
-  FrameResult finished;
-  FinishCurrentKeyframe(&finished);
-  mapper_.Clear();
-  current_ = CurrentKeyframe{};
-  ++map_generation_;
-  current_map_ = next_map_++;
-  ++backend_stats_.maps_started;
-  start_ = StartState::kNoKeyframe;
-  depth_updates_ = 0;
-  lost_in_a_row_ = 0;
-  initial_frames_.clear();
-  bootstrap_.reset();
-  pending_pair_.reset();
-  FrameResult result = StartFirstKeyframe(frame, image);
-  SystemEvent started{SystemEvent::Kind::kNewMap, frame->Id(),
-                      result.is_keyframe ? frame->Id() : -1};
-  started.map_id = current_map_;
-  result.events.insert(result.events.begin(), started);
-  result.events.insert(result.events.begin(), finished.events.begin(), finished.events.end());
-  return result;
+  auto& [next, s] = *propagated;
+  // Normalising multiplies idepth by s, so a point's new-keyframe coordinates become
+  // p' = p / s; the keyframe-to-world similarity absorbs it: S_w_new = S_w_c * Sim3(s).
+  const Sim3d S_w_c = CurrentKeyframePose() * Sim3d(tracked.T_kf_frame);
+  const SE3d& last_motion = tracker_.State().T_prev_last;
+  const SE3d velocity(last_motion.Rotation(), last_motion.Translation() / s);
+  StartKeyframe(frame, S_w_c * Sim3d(s, SO3d(), Eigen::Vector3d::Zero()), std::move(next), result);
+  SetPose(result, SE3d());  // the frame is the new keyframe
+  mapper_.Direction().SetKeyframe(frame->Id(), image);
+  // Constant-velocity guess for the next frame in the new keyframe's units.
+  tracker_.SetState(MotionState{SE3d(), velocity, AffineBrightness{}, 0});
+  result->is_keyframe = true;
 }
 
 std::vector<Eigen::Vector3f> System::MapPoints() const {
@@ -553,6 +392,10 @@ void BackendStats::Add(const BackendStats& other) {
   relocalisations += other.relocalisations;
   maps_started += other.maps_started;
   merges += other.merges;
+  frames_diverged += other.frames_diverged;
+  depth_estimates_diverged += other.depth_estimates_diverged;
+  keyframes_diverged += other.keyframes_diverged;
+  backend_steps_diverged += other.backend_steps_diverged;
 }
 
 BackendStats System::Backend() const {

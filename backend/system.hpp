@@ -178,6 +178,9 @@ struct SystemEvent {
     kRelocalised,       ///< lost beyond the recent keyframes, found again on keyframe_id
     kNewMap,            ///< lost too long: map_id started (keyframe_id: its first keyframe)
     kMapsMerged,        ///< a loop joined map_id into the map of loop_keyframe_id
+    /// A stage's result diverged numerically (docs/reliability.md, "Divergence") and was
+    /// dropped: keyframe_id is the keyframe it concerned, which stays as it was.
+    kDiverged,
   };
   Kind kind = Kind::kLost;
   std::int64_t frame_id = 0;
@@ -226,6 +229,14 @@ struct BackendStats {
   int relocalisations = 0;
   int maps_started = 0;  ///< new maps after long loss (the first map not counted)
   int merges = 0;
+  /// Numerical divergence caught at stage boundaries (docs/reliability.md, "Divergence"):
+  /// frames whose tracking diverged (reported lost), depth estimates removed as non-finite or
+  /// non-positive, keyframes not made because the propagated map diverged, keyframes whose backend
+  /// step diverged (their chain edge kept).
+  int frames_diverged = 0;
+  int depth_estimates_diverged = 0;
+  int keyframes_diverged = 0;
+  int backend_steps_diverged = 0;
 
   /// Adds `other`'s counts and appends its timings.
   void Add(const BackendStats& other);
@@ -437,6 +448,10 @@ class System {
   TrackingResult TrackFrame(const Frame& frame, FrameResult* result);
   void MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
                 const TrackingResult& tracked, FrameResult* result);
+  /// Makes `frame` the new keyframe (depth propagated to it), or reports kDiverged and keeps
+  /// the current one when the propagated map diverged.
+  void SwitchKeyframe(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
+                      const TrackingResult& tracked, FrameResult* result);
   // Initialisation (system_initialization.cpp).
   FrameResult StartFirstKeyframe(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
   std::vector<RevisedPose> FinishInitialisation();

@@ -9,6 +9,7 @@
 #include "backend/mapping_worker.hpp"
 #include "backend/system.hpp"
 #include "core/check.hpp"
+#include "core/divergence.hpp"
 #include "core/stopwatch.hpp"
 
 namespace parallax {
@@ -158,7 +159,16 @@ FrameResult System::ProcessLive(std::int64_t id, double timestamp, const ImageU8
 System::LiveStep System::TrackLive(const Frame& frame, const LiveSnapshot& snapshot) {
   LiveStep step;
   const auto start = Clock::now();
-  live_->arena.execute([&] { step.tracked = live_->tracker.Track(*snapshot.reference, frame); });
+  live_->arena.execute([&] {
+    try {
+      step.tracked = live_->tracker.Track(*snapshot.reference, frame);
+    } catch (const NumericalDivergence& e) {
+      // Lost, with the tracker's state as before: the mapping thread tries the frame again.
+      step.tracked = TrackingResult{};
+      step.tracked.stats.diverged = true;
+      step.tracked.stats.reason = std::string("tracking diverged: ") + e.what();
+    }
+  });
   step.tracking_ms = MillisecondsSince(start);
   if (step.tracked.status == TrackingStatus::kLost) return step;
   // The keyframe rule of MapFrame: a frame that wants a new keyframe is never skipped by

@@ -2,13 +2,15 @@
 
 #include <stdexcept>
 
+#include "core/divergence.hpp"
+
 namespace parallax {
 
 template <typename Scalar>
 SE3<Scalar>::SE3(const SO3<Scalar>& rotation, const Vector3& translation)
     : rotation_(rotation), translation_(translation) {
   if (!translation.allFinite()) {
-    throw std::invalid_argument("SE3: translation must be finite");
+    throw NumericalDivergence("SE3: translation must be finite");
   }
 }
 

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/divergence.hpp"
 #include "core/lie_coefficients.hpp"
 
 namespace parallax {
@@ -22,9 +23,9 @@ template <typename Scalar>
 Sim3<Scalar>::Sim3(Scalar scale, const SO3<Scalar>& rotation, const Vector3& translation)
     : scale_(scale), rotation_(rotation), translation_(translation) {
   if (!std::isfinite(scale) || !(scale > Scalar(0))) {
-    throw std::invalid_argument("Sim3: scale must be finite and > 0, got " + std::to_string(scale));
+    throw NumericalDivergence("Sim3: scale must be finite and > 0, got " + std::to_string(scale));
   }
-  if (!translation.allFinite()) throw std::invalid_argument("Sim3: translation must be finite");
+  if (!translation.allFinite()) throw NumericalDivergence("Sim3: translation must be finite");
 }
 
 template <typename Scalar>

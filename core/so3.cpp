@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/divergence.hpp"
 #include "core/lie_coefficients.hpp"
 
 namespace parallax {
@@ -12,8 +13,8 @@ template <typename Scalar>
 SO3<Scalar>::SO3(const Quaternion& q) {
   const Scalar norm = q.norm();
   if (!std::isfinite(norm) || norm < Scalar(1e-6)) {
-    throw std::invalid_argument("SO3: quaternion must be finite and non-zero, norm is " +
-                                std::to_string(norm));
+    throw NumericalDivergence("SO3: quaternion must be finite and non-zero, norm is " +
+                              std::to_string(norm));
   }
   q_ = Quaternion(q.coeffs() / norm);
 }
@@ -25,8 +26,10 @@ SO3<Scalar>::SO3(const Matrix3& R) {
   const double orthogonality =
       (Rd.transpose() * Rd - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   const double det = Rd.determinant();
-  if (!std::isfinite(orthogonality) || orthogonality > tolerance ||
-      std::abs(det - 1.0) > tolerance) {
+  if (!std::isfinite(orthogonality) || !std::isfinite(det)) {
+    throw NumericalDivergence("SO3: matrix is not finite");
+  }
+  if (orthogonality > tolerance || std::abs(det - 1.0) > tolerance) {
     throw std::invalid_argument(
         "SO3: matrix is not a rotation (max |R^T R - I| = " + std::to_string(orthogonality) +
         ", det = " + std::to_string(det) + ")");

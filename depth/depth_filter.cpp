@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "core/check.hpp"
+#include "core/divergence.hpp"
 
 namespace parallax {
 namespace {
@@ -52,6 +53,7 @@ void Add(DepthUpdateStats* total, const DepthUpdateStats& s) {
   total->no_match += s.no_match;
   total->out_of_image += s.out_of_image;
   total->skipped += s.skipped;
+  total->diverged += s.diverged;
 }
 
 }  // namespace
@@ -66,6 +68,11 @@ void DepthFilter::UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search
   if (!map->eligible[i] || map->blacklist[i] < -1) return;
   ++stats->attempted;
   const bool has_prior = map->valid[i] != 0;
+  if (has_prior && !HealthyEstimate(map->idepth[i], map->variance[i])) {
+    Invalidate(map, i);  // a diverged prior would steer the search with NaN bounds
+    ++stats->diverged;
+    return;
+  }
   StereoObservation obs;
   if (has_prior) {
     const float mu = map->idepth[i], sigma = std::sqrt(map->variance[i]);
@@ -105,6 +112,10 @@ void DepthFilter::UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search
       return;
   }
   if (!has_prior) {
+    if (!HealthyEstimate(obs.idepth, obs.variance)) {
+      ++stats->diverged;
+      return;
+    }
     map->idepth[i] = obs.idepth;
     map->variance[i] = obs.variance;
     map->validity[i] = options_.initial_validity;
@@ -129,6 +140,11 @@ void DepthFilter::UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search
   map->idepth[i] =
       (prior_var * obs.idepth + obs.variance * map->idepth[i]) / (prior_var + obs.variance);
   map->variance[i] = prior_var * obs.variance / (prior_var + obs.variance);
+  if (!HealthyEstimate(map->idepth[i], map->variance[i])) {
+    Invalidate(map, i);
+    ++stats->diverged;
+    return;
+  }
   const float g = std::sqrt(map->Keyframe().Level(0).grad_sq(x, y));
   map->validity[i] =
       std::min(map->validity[i] + options_.validity_gain, 5.0f + 250.0f * g / 255.0f);
@@ -149,17 +165,24 @@ DepthUpdateStats DepthFilter::Update(InverseDepthMap* map, const StereoFrame& fr
   });
   DepthUpdateStats total;
   for (const DepthUpdateStats& s : per_row) Add(&total, s);
-  Regularize(map);
+  total.diverged += Regularize(map);
   return total;
 }
 
-void DepthFilter::Regularize(InverseDepthMap* map) const {
+int DepthFilter::Regularize(InverseDepthMap* map) const {
   const int w = map->Width(), h = map->Height();
   // Inverse variances once per pixel (0 for invalid ones), and the distance decay as a table:
   // the 5x5 loop below is then multiplications only.
   std::vector<float> inv_var(map->valid.size(), 0.0f);
+  int diverged = 0;
   for (std::size_t i = 0; i < inv_var.size(); ++i) {
-    if (map->valid[i]) inv_var[i] = 1.0f / map->variance[i];
+    if (!map->valid[i]) continue;
+    if (!HealthyEstimate(map->idepth[i], map->variance[i])) {
+      Invalidate(map, i);
+      ++diverged;
+      continue;
+    }
+    inv_var[i] = 1.0f / map->variance[i];
   }
   // Inverse variance, decaying mildly with distance (scale-free form of LSD's
   // 1 / (var + dist^2 * REG_DIST_VAR)).
@@ -182,6 +205,7 @@ void DepthFilter::Regularize(InverseDepthMap* map) const {
   for (std::size_t i = 0; i < keep.size(); ++i) {
     if (map->valid[i] && !keep[i]) Invalidate(map, i);
   }
+  return diverged;
 }
 
 void DepthFilter::RegularizePixel(InverseDepthMap* map_ptr, const std::vector<float>& inv_var,
@@ -212,7 +236,8 @@ void DepthFilter::RegularizePixel(InverseDepthMap* map_ptr, const std::vector<fl
   map.variance_smoothed[i] = std::min(var_i, 1.0f / sum_w);
   // Removed: too little support around it, or observed neighbours mostly disagree (a wrong
   // match that later observations within its own mu +- 2 sigma cannot correct).
-  *keep = support >= options_.min_neighbour_validity && !(disagree > agree);
+  *keep = support >= options_.min_neighbour_validity && !(disagree > agree) &&
+          HealthyEstimate(map.idepth_smoothed[i], map.variance_smoothed[i]);
 }
 
 int DepthFilter::FillHoles(InverseDepthMap* map) const {
@@ -252,6 +277,9 @@ int DepthFilter::FillHoles(InverseDepthMap* map) const {
 
 float DepthFilter::NormalizeScale(InverseDepthMap* map) const {
   const double mean = map->MeanSmoothedIdepth();
+  if (!std::isfinite(mean)) {
+    throw NumericalDivergence("depth map: the mean inverse depth is not finite");
+  }
   if (!(mean > 0.0)) return 1.0f;
   const auto s = static_cast<float>(1.0 / mean);
   map->Rescale(s);

@@ -25,6 +25,9 @@ struct DepthUpdateStats {
   int no_match = 0;
   int out_of_image = 0;
   int skipped = 0;  ///< gradient not along the epipolar line, or too much rescale
+  /// Estimates removed because fusion or regularisation left them non-finite or
+  /// non-positive (numerical divergence; 0 in every run measured so far).
+  int diverged = 0;
 };
 
 struct PropagationStats {
@@ -34,6 +37,8 @@ struct PropagationStats {
   int rejected = 0;  ///< intensity mismatch or no gradient in the new keyframe
   int merged = 0;    ///< collisions fused
   int occluded = 0;  ///< collisions where the nearer point won
+  /// Old-map estimates not moved because they were non-finite or non-positive (divergence).
+  int diverged = 0;
 };
 
 class DepthFilter {
@@ -46,8 +51,10 @@ class DepthFilter {
   DepthUpdateStats Update(InverseDepthMap* map, const StereoFrame& frame) const;
 
   /// Smoothed idepth/variance from compatible neighbours in a 5x5 window; pixels with too
-  /// little neighbour support are removed (outliers).
-  void Regularize(InverseDepthMap* map) const;
+  /// little neighbour support are removed (outliers). It ends every stage that changes a
+  /// map, so it is also the map's divergence check: estimates that are not healthy
+  /// (core/divergence.hpp) are removed first. Returns how many were.
+  int Regularize(InverseDepthMap* map) const;
   /// Fills empty eligible pixels whose neighbourhood has enough valid support.
   int FillHoles(InverseDepthMap* map) const;
 
@@ -61,7 +68,8 @@ class DepthFilter {
 
   /// Rescales the map so the mean smoothed inverse depth is 1 and returns the factor s applied
   /// (idepth x s). The keyframe's world scale changes by 1/s; its Sim(3) pose must take it.
-  /// Returns 1 and leaves the map unchanged when it has no estimates.
+  /// Returns 1 and leaves the map unchanged when it has no estimates. Throws
+  /// NumericalDivergence when the mean is not finite (the map diverged).
   float NormalizeScale(InverseDepthMap* map) const;
 
   const DepthFilterOptions& Options() const { return options_; }

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/check.hpp"
+#include "core/divergence.hpp"
 #include "depth/depth_filter.hpp"
 
 namespace parallax {
@@ -28,6 +29,10 @@ InverseDepthMap DepthFilter::Propagate(const InverseDepthMap& old_map,
       const std::size_t i = old_map.Index(x, y);
       if (!old_map.valid[i]) continue;
       ++st.source;
+      if (!HealthyEstimate(old_map.idepth[i], old_map.variance[i])) {
+        ++st.diverged;
+        continue;
+      }
       const double d_old = old_map.idepth[i];
       const Eigen::Vector3d p = R * (K.Unproject(Eigen::Vector2d(x, y)) / d_old) + t;
       if (!(p.z() > 0.0)) {
@@ -83,9 +88,9 @@ InverseDepthMap DepthFilter::Propagate(const InverseDepthMap& old_map,
     map.idepth_smoothed[i] = map.idepth[i];
     map.variance_smoothed[i] = map.variance[i];
   }
-  Regularize(&map);
+  st.diverged += Regularize(&map);
   FillHoles(&map);
-  Regularize(&map);
+  st.diverged += Regularize(&map);
   return map;
 }
 

@@ -97,6 +97,11 @@ void WriteStats(const std::string& path, const RunSummary& s) {
       {"maps", s.maps},
       {"maps_started", s.maps_started},
       {"merges", s.merges},
+      {"divergences",
+       {{"frames", s.frames_diverged},
+        {"depth_estimates", s.depth_estimates_diverged},
+        {"keyframes", s.keyframes_diverged},
+        {"backend_steps", s.backend_steps_diverged}}},
       {"initialised_at_frame", s.initialised_at_frame},
       {"wall_s", s.wall_s},
       {"fps", s.fps},
@@ -164,6 +169,9 @@ std::string EventNames(const std::vector<SystemEvent>& events) {
         break;
       case SystemEvent::Kind::kMapsMerged:
         names += "merged:" + std::to_string(e.map_id);
+        break;
+      case SystemEvent::Kind::kDiverged:
+        names += "diverged:" + std::to_string(e.keyframe_id);
         break;
     }
   }

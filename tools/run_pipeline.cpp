@@ -78,6 +78,11 @@ void Summarise(const System& system, const Timings& timings,
   summary->maps = system.Graph().NumMaps();
   summary->maps_started = system.Backend().maps_started;
   summary->merges = system.Backend().merges;
+  const BackendStats backend = system.Backend();
+  summary->frames_diverged = backend.frames_diverged;
+  summary->depth_estimates_diverged = backend.depth_estimates_diverged;
+  summary->keyframes_diverged = backend.keyframes_diverged;
+  summary->backend_steps_diverged = backend.backend_steps_diverged;
   summary->latency_ms_p50 = Percentile(timings.latency_ms, 0.5);
   summary->latency_ms_p95 = Percentile(timings.latency_ms, 0.95);
   summary->latency_ms_max = Percentile(timings.latency_ms, 1.0);

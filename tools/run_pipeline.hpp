@@ -80,6 +80,11 @@ struct RunSummary {
   int maps = 0;                     ///< maps in the final graph (1 when every new map was merged)
   int maps_started = 0;             ///< new maps after long loss
   int merges = 0;
+  /// Numerical divergence caught at stage boundaries (BackendStats, docs/reliability.md).
+  int frames_diverged = 0;
+  int depth_estimates_diverged = 0;
+  int keyframes_diverged = 0;
+  int backend_steps_diverged = 0;
   /// Wall time of each ProcessFrame call (what a caller waits for a pose), ms.
   double latency_ms_p50 = 0.0, latency_ms_p95 = 0.0, latency_ms_max = 0.0;
   /// Real-time mode only.

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <unsupported/Eigen/MatrixFunctions>
 
+#include "core/divergence.hpp"
 #include "core/lie_coefficients.hpp"
 #include "tests/core/lie_test_utils.hpp"
 
@@ -77,13 +78,15 @@ TEST(Sim3, ScaleComposesMultiplicatively) {
 }
 
 TEST(Sim3, RejectsNonPositiveOrNonFiniteScale) {
+  // Numerical divergence (docs/reliability.md), which is also bad input to a caller.
+  EXPECT_THROW(Sim3d(0.0, SO3d(), Eigen::Vector3d::Zero()), NumericalDivergence);
+  EXPECT_THROW(Sim3d(-1.0, SO3d(), Eigen::Vector3d::Zero()), NumericalDivergence);
+  EXPECT_THROW(Sim3d(NAN, SO3d(), Eigen::Vector3d::Zero()), NumericalDivergence);
+  EXPECT_THROW(Sim3d(1.0, SO3d(), Eigen::Vector3d(0, INFINITY, 0)), NumericalDivergence);
   EXPECT_THROW(Sim3d(0.0, SO3d(), Eigen::Vector3d::Zero()), std::invalid_argument);
-  EXPECT_THROW(Sim3d(-1.0, SO3d(), Eigen::Vector3d::Zero()), std::invalid_argument);
-  EXPECT_THROW(Sim3d(NAN, SO3d(), Eigen::Vector3d::Zero()), std::invalid_argument);
-  EXPECT_THROW(Sim3d(1.0, SO3d(), Eigen::Vector3d(0, INFINITY, 0)), std::invalid_argument);
   Eigen::Matrix<float, 7, 1> huge = Eigen::Matrix<float, 7, 1>::Zero();
   huge[6] = 200.0f;  // exp(200) overflows float: must be reported, not propagated
-  EXPECT_THROW(Sim3f::Exp(huge), std::invalid_argument);
+  EXPECT_THROW(Sim3f::Exp(huge), NumericalDivergence);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include <numbers>
 
+#include "core/divergence.hpp"
 #include "core/se3.hpp"
 #include "tests/core/lie_test_utils.hpp"
 
@@ -54,8 +55,9 @@ TEST(SO3, LogJacobianIsLeftJacobianInverse) {
 }
 
 TEST(SO3, RejectsInvalidInput) {
-  EXPECT_THROW(SO3d(Eigen::Quaterniond(0, 0, 0, 0)), std::invalid_argument);
-  EXPECT_THROW(SO3d(Eigen::Quaterniond(NAN, 0, 0, 1)), std::invalid_argument);
+  EXPECT_THROW(SO3d(Eigen::Quaterniond(0, 0, 0, 0)), NumericalDivergence);
+  EXPECT_THROW(SO3d(Eigen::Quaterniond(NAN, 0, 0, 1)), NumericalDivergence);
+  EXPECT_THROW(SO3d(Eigen::Matrix3d::Constant(NAN)), NumericalDivergence);
   EXPECT_THROW(SO3d(Eigen::Matrix3d(2.0 * Eigen::Matrix3d::Identity())), std::invalid_argument);
   Eigen::Matrix3d reflection = Eigen::Matrix3d::Identity();
   reflection(2, 2) = -1.0;
@@ -88,7 +90,7 @@ TEST(SE3, PointFrameConvention) {
 }
 
 TEST(SE3, RejectsInvalidInput) {
-  EXPECT_THROW(SE3d(SO3d(), Eigen::Vector3d(NAN, 0, 0)), std::invalid_argument);
+  EXPECT_THROW(SE3d(SO3d(), Eigen::Vector3d(NAN, 0, 0)), NumericalDivergence);
   Eigen::Matrix4d bad = Eigen::Matrix4d::Identity();
   bad(3, 0) = 1.0;
   EXPECT_THROW(SE3d{bad}, std::invalid_argument);

@@ -30,6 +30,8 @@ px_event_type EventType(SystemEvent::Kind kind, bool* wanted) {
       return PX_EVENT_RECOVERED;
     case SystemEvent::Kind::kRestarted:
       return PX_EVENT_RESTARTED;
+    case SystemEvent::Kind::kDiverged:
+      return PX_EVENT_DIVERGED;
     case SystemEvent::Kind::kKeyframeFinished:
       break;  // internal bookkeeping
   }

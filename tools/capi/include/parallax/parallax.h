@@ -172,7 +172,9 @@ typedef enum {
   PX_EVENT_MAPS_MERGED = 6,   /* map_id was joined to the map of other_keyframe_id */
   PX_EVENT_POSES_REVISED = 7, /* earlier frames' poses were revised (initialisation) */
   PX_EVENT_RECOVERED = 8,     /* frame_id tracked again on a recent keyframe_id */
-  PX_EVENT_RESTARTED = 9      /* the start failed and began again at frame_id */
+  PX_EVENT_RESTARTED = 9,     /* the start failed and began again at frame_id */
+  PX_EVENT_DIVERGED = 10      /* a numerical divergence was caught and its result dropped:
+                                 keyframe_id stays as it was (docs/reliability.md) */
 } px_event_type;
 
 typedef struct {
