@@ -6,8 +6,26 @@
 
 namespace parallax {
 
-MappingWorker::MappingWorker(Process process, std::size_t max_pending, int threads)
-    : process_(std::move(process)), max_pending_(max_pending), arena_(threads) {
+namespace {
+
+#if defined(__SANITIZE_THREAD__)
+constexpr bool kThreadSanitizer = true;  // g++
+#elif defined(__has_feature)
+constexpr bool kThreadSanitizer = __has_feature(thread_sanitizer);  // clang
+#else
+constexpr bool kThreadSanitizer = false;
+#endif
+
+}  // namespace
+
+int MappingWorker::ArenaWidth(int threads) { return kThreadSanitizer ? 1 : threads; }
+
+MappingWorker::MappingWorker(Process process, std::size_t max_pending, int threads,
+                             int waited_threads)
+    : process_(std::move(process)),
+      max_pending_(max_pending),
+      arena_(ArenaWidth(threads)),
+      waited_arena_(ArenaWidth(waited_threads)) {
   CheckArgument(max_pending_ >= 1, "MappingWorker: max_pending must be >= 1");
   thread_ = std::thread([this] { Loop(); });
 }
@@ -104,7 +122,7 @@ void MappingWorker::Loop() {
     const bool waited = entry.done != nullptr;
     std::exception_ptr error;
     std::optional<FrameResult> result;
-    arena_.execute([&] {
+    (waited ? waited_arena_ : arena_).execute([&] {
       try {
         result = process_(entry.job);
       } catch (...) {

@@ -50,8 +50,9 @@ class MappingWorker {
   using Process = std::function<FrameResult(const MappingJob&)>;
 
   /// `process` maps a job. `max_pending`: refinement jobs that may wait (>= 1); `threads`:
-  /// the TBB concurrency of the thread's arena. The thread starts here.
-  MappingWorker(Process process, std::size_t max_pending, int threads);
+  /// the TBB concurrency of the thread's arena; `waited_threads`: that of the jobs the caller
+  /// waits for (Run), while the caller's thread is idle. The thread starts here.
+  MappingWorker(Process process, std::size_t max_pending, int threads, int waited_threads);
   /// Stop().
   ~MappingWorker();
   MappingWorker(const MappingWorker&) = delete;
@@ -75,6 +76,11 @@ class MappingWorker {
   /// Refinements skipped because mapping was behind.
   std::int64_t Skipped() const;
 
+  /// The TBB concurrency an arena asked for `threads` gets: `threads`, or 1 in a
+  /// ThreadSanitizer build (libtbb is not instrumented, so TSan cannot see the
+  /// synchronisation of TBB's worker threads and reports their parallel loops as races).
+  static int ArenaWidth(int threads);
+
  private:
   struct Entry {
     MappingJob job;
@@ -87,6 +93,7 @@ class MappingWorker {
   Process process_;
   std::size_t max_pending_;
   tbb::task_arena arena_;
+  tbb::task_arena waited_arena_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;  ///< a job was queued, or stop
   std::condition_variable idle_;  ///< a job finished

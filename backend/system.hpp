@@ -54,6 +54,10 @@ struct RealtimeOptions {
   /// budget is one each, so that neither oversubscribes the other.
   int tracking_threads = 1;
   int mapping_threads = 1;
+  /// TBB concurrency of the mapping jobs the caller waits for (the start, frames lost
+  /// live): tracking is idle meanwhile, so they may have both cores. (Under ThreadSanitizer
+  /// every real-time arena is one thread wide: libtbb is not instrumented.)
+  int waited_mapping_threads = 2;
   /// OpenCV's thread pool (ORB extraction on the mapping thread) is process-wide: a
   /// real-time System sets it to this when it starts.
   int opencv_threads = 1;

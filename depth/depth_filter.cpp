@@ -54,12 +54,20 @@ void Add(DepthUpdateStats* total, const DepthUpdateStats& s) {
   total->out_of_image += s.out_of_image;
   total->skipped += s.skipped;
   total->diverged += s.diverged;
+  total->converged_skipped += s.converged_skipped;
 }
 
 }  // namespace
 
-DepthFilter::DepthFilter(const DepthFilterOptions& options) : options_(options) {
+DepthFilter::DepthFilter(const DepthFilterOptions& options)
+    : options_(options),
+      converged_sigma_sq_(options.converged_relative_sigma * options.converged_relative_sigma),
+      converged_recheck_(static_cast<std::size_t>(std::max(1, options.converged_recheck))) {
   options_.Check();
+}
+
+bool DepthFilter::Converged(const InverseDepthMap& map, std::size_t i) const {
+  return map.variance[i] < converged_sigma_sq_ * map.idepth[i] * map.idepth[i];
 }
 
 void DepthFilter::UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search, int x, int y,
@@ -71,6 +79,10 @@ void DepthFilter::UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search
   if (has_prior && !HealthyEstimate(map->idepth[i], map->variance[i])) {
     Invalidate(map, i);  // a diverged prior would steer the search with NaN bounds
     ++stats->diverged;
+    return;
+  }
+  if (has_prior && Converged(*map, i) && (i + map->updates) % converged_recheck_ != 0) {
+    ++stats->converged_skipped;
     return;
   }
   StereoObservation obs;
@@ -163,6 +175,7 @@ DepthUpdateStats DepthFilter::Update(InverseDepthMap* map, const StereoFrame& fr
     DepthUpdateStats& s = per_row[static_cast<std::size_t>(y)];
     for (int x = 0; x < map->Width(); ++x) UpdatePixel(map, search, x, y, &s);
   });
+  ++map->updates;
   DepthUpdateStats total;
   for (const DepthUpdateStats& s : per_row) Add(&total, s);
   total.diverged += Regularize(map);

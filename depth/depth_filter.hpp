@@ -28,6 +28,8 @@ struct DepthUpdateStats {
   /// Estimates removed because fusion or regularisation left them non-finite or
   /// non-positive (numerical divergence; 0 in every run measured so far).
   int diverged = 0;
+  /// Converged estimates this update did not re-observe (DepthFilterOptions pixel budget).
+  int converged_skipped = 0;
 };
 
 struct PropagationStats {
@@ -80,7 +82,11 @@ class DepthFilter {
   /// Smooths valid pixel (x, y) over its 5x5 neighbourhood; `keep` = 0 when it is an outlier.
   void RegularizePixel(InverseDepthMap* map, const std::vector<float>& inv_var,
                        const std::array<float, 25>& decay, int x, int y, std::uint8_t* keep) const;
+  /// Standard deviation below converged_relative_sigma of the inverse depth.
+  bool Converged(const InverseDepthMap& map, std::size_t i) const;
   DepthFilterOptions options_;
+  float converged_sigma_sq_;
+  std::size_t converged_recheck_;
 };
 
 }  // namespace parallax

@@ -28,6 +28,9 @@ void DepthFilterOptions::Check() const {
               "min_search_length", "must be in [2, max_search_length]");
   CheckOption(min_rescale > 0.0f && max_rescale > min_rescale, s, "min_rescale/max_rescale",
               "need 0 < min < max");
+  CheckOption(converged_relative_sigma >= 0.0f && converged_relative_sigma < 1.0f, s,
+              "converged_relative_sigma", "must be in [0, 1)");
+  CheckOption(converged_recheck >= 1, s, "converged_recheck", "must be >= 1");
 }
 
 InverseDepthMap::InverseDepthMap(std::shared_ptr<const Frame> keyframe,

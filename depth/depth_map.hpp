@@ -58,6 +58,9 @@ class InverseDepthMap {
   /// Stereo observations fused (or that created the estimate); 0 for random or hole-filled
   /// values, which are hypotheses until observed.
   std::vector<std::uint16_t> observations;
+  /// Stereo updates made on this map (DepthFilter::Update): picks which converged estimates
+  /// an update re-observes (DepthFilterOptions::converged_recheck).
+  std::uint32_t updates = 0;
 
   /// Valid with at least one stereo observation (or from a prior).
   bool IsConfirmed(std::size_t i) const { return valid[i] && observations[i] > 0; }

@@ -21,8 +21,10 @@ struct LoopRun {
   Trajectory online_poses;
 };
 
-LoopRun RunSequence(const test::TempDirAt& dir, const std::string& name, bool loop_closure) {
+LoopRun RunSequence(const test::TempDirAt& dir, const std::string& name, bool loop_closure,
+                    const SystemOptions& system = {}) {
   RunOptions run;
+  run.system = system;
   run.dataset = dir.File("seq");
   run.out_dir = dir.File(name);
   run.system.loop_closure.enabled = loop_closure;
@@ -71,7 +73,11 @@ TEST(LoopClosure, AFullOrbitClosesItsLoopAndTheMapFollows) {
 
 TEST(LoopClosure, AnOrbitEndingAtItsStartClosesTheLoopAtTheEndOfTheInput) {
   // Seed 4: only the last keyframe, never finished by a later one, sees the start well
-  // enough twice in a row; FinishMapping puts it through the backend at the end.
+  // enough twice in a row; FinishMapping puts it through the backend at the end. (With the
+  // depth filter's pixel budget the loop closes before the end on this seed, 0.131% against
+  // 0.163% without: the scenario is kept with every estimate observed every update.)
+  SystemOptions system;
+  system.depth.converged_relative_sigma = 0.0f;
   const test::TempDirAt dir("parallax_loop_orbit_end");
   synth::SynthOptions options;
   options.scene = "room";
@@ -79,8 +85,8 @@ TEST(LoopClosure, AnOrbitEndingAtItsStartClosesTheLoopAtTheEndOfTheInput) {
   options.frames = 300;
   options.seed = 4;
   synth::WriteSyntheticSequence(options, dir.File("seq"));
-  const LoopRun with = RunSequence(dir, "with", true);
-  const LoopRun without = RunSequence(dir, "without", false);
+  const LoopRun with = RunSequence(dir, "with", true, system);
+  const LoopRun without = RunSequence(dir, "without", false, system);
   RecordProperty("ate_percent_with", std::to_string(with.ate_percent));
   RecordProperty("ate_percent_without", std::to_string(without.ate_percent));
   EXPECT_NE(with.summary.end_events.find("loop:"), std::string::npos) << with.summary.end_events;

@@ -4,6 +4,7 @@
 // started and stopped mid-stream, and several systems fed from several threads.
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
@@ -50,7 +51,7 @@ struct GatedProcess {
 
 TEST(MappingWorker, WhenBehindTheOldestWaitingRefinementIsSkipped) {
   GatedProcess process;
-  MappingWorker worker(process.Function(), 1, 1);
+  MappingWorker worker(process.Function(), 1, 1, 1);
   worker.Offer(Job(0));  // taken by the thread, blocked at the gate (or still queued)
   for (int id = 1; id <= 5; ++id) worker.Offer(Job(id));
   MappingJob kept = Job(6);
@@ -69,7 +70,7 @@ TEST(MappingWorker, WhenBehindTheOldestWaitingRefinementIsSkipped) {
 TEST(MappingWorker, AWaitedJobRunsAfterTheQueuedOnesAndExceptionsReachTheCaller) {
   GatedProcess process;
   process.open.set_value();
-  MappingWorker worker(process.Function(), 4, 1);
+  MappingWorker worker(process.Function(), 4, 1, 1);
   worker.Offer(Job(1));
   worker.Run(Job(2));
   EXPECT_EQ(process.seen, (std::vector<std::int64_t>{1, 2}));
@@ -81,9 +82,23 @@ TEST(MappingWorker, AWaitedJobRunsAfterTheQueuedOnesAndExceptionsReachTheCaller)
   EXPECT_EQ(process.seen.back(), 3);
 }
 
+TEST(MappingWorker, AWaitedJobHasTheWiderArena) {
+  std::vector<int> widths;
+  MappingWorker worker(
+      [&](const MappingJob&) {
+        widths.push_back(tbb::this_task_arena::max_concurrency());  // one job at a time
+        return FrameResult{};
+      },
+      4, 1, 2);
+  worker.Offer(Job(1));
+  worker.Run(Job(2));
+  EXPECT_EQ(widths, (std::vector<int>{1, MappingWorker::ArenaWidth(2)}));
+  EXPECT_GE(MappingWorker::ArenaWidth(2), 1);  // 2, or 1 under ThreadSanitizer
+}
+
 TEST(MappingWorker, StopDropsWaitingJobsAndRefusesNewOnes) {
   GatedProcess process;
-  MappingWorker worker(process.Function(), 8, 1);
+  MappingWorker worker(process.Function(), 8, 1, 1);
   for (int id = 0; id < 5; ++id) worker.Offer(Job(id));
   std::thread opener([&] { process.open.set_value(); });
   worker.Stop();
@@ -95,7 +110,7 @@ TEST(MappingWorker, StopDropsWaitingJobsAndRefusesNewOnes) {
 
 TEST(MappingWorker, AKeyframeRequestGoesBeforeWaitingRefinementsAndCanBeWaitedFor) {
   GatedProcess process;
-  MappingWorker worker(process.Function(), 4, 1);
+  MappingWorker worker(process.Function(), 4, 1, 1);
   worker.Offer(Job(0));
   worker.Offer(Job(1));
   worker.Offer(Job(2));
@@ -120,7 +135,7 @@ TEST(MappingWorker, AKeyframeRequestGoesBeforeWaitingRefinementsAndCanBeWaitedFo
 
 TEST(MappingWorker, AWaitForEndsWhenTheWorkerStops) {
   GatedProcess process;
-  MappingWorker worker(process.Function(), 4, 1);
+  MappingWorker worker(process.Function(), 4, 1, 1);
   MappingJob kept = Job(5);
   kept.keep = true;
   worker.Offer(std::move(kept));
