@@ -1,8 +1,17 @@
 #include "backend/frame_tracker.hpp"
 
+#include <string>
+
 namespace parallax {
 
 FrameTracker::FrameTracker(const Se3TrackerOptions& options) : tracker_(options) {}
+
+TrackingResult DivergedTracking(const std::exception& divergence) {
+  TrackingResult result;  // lost
+  result.stats.diverged = true;
+  result.stats.reason = std::string("tracking diverged: ") + divergence.what();
+  return result;
+}
 
 TrackingResult FrameTracker::Track(const TrackingReference& reference, const Frame& frame) {
   TrackingResult tracked = tracker_.Track(

@@ -3,6 +3,7 @@
 // constant-velocity motion hypotheses; recovery on recent keyframes. Never touches depth.
 
 #include <cstddef>
+#include <exception>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -28,6 +29,10 @@ struct RecoveryCandidate {
   const TrackingReference* reference = nullptr;
   Sim3d S_w_kf;
 };
+
+/// The result a tracking call reports when it threw NumericalDivergence: lost, `diverged`,
+/// the reason naming the divergence (docs/reliability.md, "Divergence").
+TrackingResult DivergedTracking(const std::exception& divergence);
 
 class FrameTracker {
  public:

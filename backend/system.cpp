@@ -234,9 +234,7 @@ TrackingResult System::TrackFrame(const Frame& frame, FrameResult* result) {
     tracked = tracker_.Track(*mapper_.Reference(), frame);
   } catch (const NumericalDivergence& e) {
     // The tracker's state changes only after a result: it is as before this frame.
-    tracked = TrackingResult{};
-    tracked.stats.diverged = true;
-    tracked.stats.reason = std::string("tracking diverged: ") + e.what();
+    tracked = DivergedTracking(e);
     ++backend_stats_.frames_diverged;
     result->events.push_back({SystemEvent::Kind::kDiverged, frame.Id(), current_.id});
   }

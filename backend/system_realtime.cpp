@@ -166,9 +166,7 @@ System::LiveStep System::TrackLive(const Frame& frame, const LiveSnapshot& snaps
       step.tracked = live_->tracker.Track(*snapshot.reference, frame);
     } catch (const NumericalDivergence& e) {
       // Lost, with the tracker's state as before: the mapping thread tries the frame again.
-      step.tracked = TrackingResult{};
-      step.tracked.stats.diverged = true;
-      step.tracked.stats.reason = std::string("tracking diverged: ") + e.what();
+      step.tracked = DivergedTracking(e);
     }
   });
   step.tracking_ms = MillisecondsSince(start);
