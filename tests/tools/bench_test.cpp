@@ -150,11 +150,57 @@ TEST(BenchRunner, PeersAreEvaluatedLikeTheRun) {
   const BenchResult r = RunBench(dir.Write("peers.yaml", suite), Options(dir, "b", 1));
   ASSERT_EQ(r.runs.size(), 1u);
   ASSERT_EQ(r.runs[0].peers.count("truth"), 1u);
-  const TrajectoryFigures& peer = r.runs[0].peers.at("truth");
+  const TrajectoryFigures& peer = r.runs[0].peers.at("truth").figures;
+  EXPECT_FALSE(r.runs[0].peers.at("truth").timed);
   ASSERT_TRUE(peer.ok) << peer.error;
   EXPECT_LT(peer.ate_rmse, 1e-6);
   EXPECT_DOUBLE_EQ(peer.coverage, 1.0);
   EXPECT_NE(ReportMarkdown(r).find("truth"), std::string::npos);
+}
+
+// A peer program runs on every sequence in the same bench run, pinned like parallax, and is
+// timed as a whole process; a failing one is reported, not thrown.
+TEST(BenchRunner, PeerProgramsAreRunTimedAndEvaluated) {
+  const TempDir dir;
+  // "truth" answers with the ground truth after 0.4 s and records its arguments.
+  const std::string truth =
+      dir.Write("truth.sh",
+                "#!/bin/sh\nsleep 0.4\nmkdir -p \"$2\"\necho \"$3\" > \"$2/max_frames\"\n"
+                "cp \"$1/groundtruth.txt\" \"$2/trajectory.txt\"\n");
+  const std::string broken = dir.Write("broken.sh", "#!/bin/sh\necho no input >&2\nexit 3\n");
+  for (const std::string& f : {truth, broken}) {
+    std::filesystem::permissions(f, std::filesystem::perms::owner_exec,
+                                 std::filesystem::perm_options::add);
+  }
+  const std::string suite =
+      "name: peers\nsequences:\n  - name: room\n    max_frames: 30\n    synth: {scene: room, "
+      "motion: shake, frames: 40, width: 320, height: 240}\n";
+  BenchOptions options = Options(dir, "p", 1);
+  options.cpus = "0";
+  options.peer_programs = {{"truth", truth}, {"broken", broken}};
+  const BenchResult r = RunBench(dir.Write("peers.yaml", suite), options);
+  ASSERT_EQ(r.runs.size(), 1u);
+  ASSERT_TRUE(r.runs[0].Ok());
+  EXPECT_GT(r.runs[0].process_ms_per_frame, 0.0);
+  EXPECT_EQ(r.runs[0].command.rfind("taskset -c 0 ", 0), 0u) << r.runs[0].command;
+  const PeerFigures& good = r.runs[0].peers.at("truth");
+  EXPECT_TRUE(good.timed);
+  ASSERT_TRUE(good.figures.ok) << good.figures.error;
+  EXPECT_LT(good.figures.ate_rmse, 1e-6);
+  EXPECT_GE(good.ms_per_frame, 400.0 / 30.0);  // 0.4 s over the 30 frames the runs see
+  std::ifstream max_frames(r.runs[0].run_dir + "/../peer-truth/repeat0/max_frames");
+  int n = 0;
+  max_frames >> n;
+  EXPECT_EQ(n, 30);
+  const PeerFigures& bad = r.runs[0].peers.at("broken");
+  EXPECT_EQ(bad.exit_code, 3);
+  EXPECT_FALSE(bad.figures.ok);
+  EXPECT_NE(bad.log_tail.find("no input"), std::string::npos);
+  const std::string md = ReportMarkdown(r);
+  EXPECT_NE(md.find("its time)"), std::string::npos) << md;
+  EXPECT_NE(md.find("failed (exit 3)"), std::string::npos) << md;
+  const nlohmann::json j = nlohmann::json::parse(ReportJson(r, "test"));
+  EXPECT_TRUE(j["runs"][0]["peers"]["truth"]["time_ratio"].is_number());
 }
 
 }  // namespace

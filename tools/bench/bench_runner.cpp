@@ -1,37 +1,24 @@
 #include "tools/bench/bench_runner.hpp"
 
-#include <fcntl.h>
 #include <fmt/format.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "tools/bench/process_pool.hpp"
 #include "tools/dataset/dataset_reader.hpp"
 #include "tools/dataset/groundtruth_files.hpp"
 #include "tools/dataset/input_error.hpp"
-
-extern char** environ;
 
 namespace fs = std::filesystem;
 
 namespace parallax::bench {
 namespace {
-
-struct Job {
-  std::size_t run_index = 0;  ///< into BenchResult::runs
-  int repeat = 0;
-  std::vector<std::string> argv;
-  std::string dir;
-};
 
 std::vector<std::string> RunArguments(const std::string& binary, const SequenceSpec& s,
                                       const Configuration& c, const std::string& dir) {
@@ -55,38 +42,6 @@ std::string Join(const std::vector<std::string>& argv) {
   return text;
 }
 
-pid_t Spawn(const Job& job) {
-  fs::create_directories(job.dir);
-  const std::string log = (fs::path(job.dir) / "run.log").string();
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
-                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  posix_spawn_file_actions_addclose(&actions, STDIN_FILENO);
-  std::vector<char*> argv;
-  for (const std::string& a : job.argv) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  const int error = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (error != 0) throw InputError(job.argv[0], "cannot start: " + std::string(strerror(error)));
-  return pid;
-}
-
-std::string Tail(const std::string& file, std::size_t lines) {
-  std::ifstream in(file);
-  std::deque<std::string> last;
-  std::string line;
-  while (std::getline(in, line)) {
-    last.push_back(line);
-    if (last.size() > lines) last.pop_front();
-  }
-  std::string text;
-  for (const std::string& l : last) text += l + "\n";
-  return text;
-}
-
 std::string ReadAll(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
   std::stringstream text;
@@ -99,42 +54,6 @@ double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t mid = v.size() / 2;
   return v.size() % 2 ? v[mid] : 0.5 * (v[mid - 1] + v[mid]);
-}
-
-/// Runs the jobs, `jobs` at a time; returns each job's exit code (in job order).
-std::vector<int> RunJobs(const std::vector<Job>& jobs, const BenchOptions& options,
-                         const std::vector<RunRecord>& runs) {
-  std::vector<int> codes(jobs.size(), -1);
-  std::map<pid_t, std::size_t> running;
-  std::size_t next = 0, done = 0;
-  const bool tty = isatty(STDERR_FILENO) != 0;
-  const auto show = [&] {
-    if (!options.progress) return;
-    std::string names;
-    for (const auto& [pid, j] : running) {
-      names += (names.empty() ? "" : ", ") + runs[jobs[j].run_index].sequence;
-    }
-    std::fprintf(stderr, "%s[%zu/%zu] running: %s%s", tty ? "\r\033[K" : "", done, jobs.size(),
-                 names.c_str(), tty ? "" : "\n");
-  };
-  while (done < jobs.size()) {
-    while (running.size() < static_cast<std::size_t>(options.jobs) && next < jobs.size()) {
-      running[Spawn(jobs[next])] = next;
-      ++next;
-    }
-    show();
-    int status = 0;
-    const pid_t pid = waitpid(-1, &status, 0);
-    if (pid < 0) throw std::runtime_error("bench: waitpid failed");
-    const auto it = running.find(pid);
-    if (it == running.end()) continue;
-    codes[it->second] = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    running.erase(it);
-    ++done;
-  }
-  if (options.progress)
-    std::fprintf(stderr, "%s[%zu/%zu] done\n", tty ? "\r\033[K" : "", done, jobs.size());
-  return codes;
 }
 
 void RenderMissing(const Suite& suite, bool progress) {
@@ -215,6 +134,91 @@ TrajectoryFigures EvaluateTrajectory(const std::string& estimate_file, const Seq
   return f;
 }
 
+namespace {
+
+/// Image frames the runs see (the dataset's, cut at max_frames).
+std::size_t SequenceFrames(const SequenceSpec& s) {
+  std::size_t n = OpenDataset(s.path)->FrameTimestamps().size();
+  if (s.max_frames > 0) n = std::min(n, static_cast<std::size_t>(s.max_frames));
+  return n;
+}
+
+/// A job of the run list: which record (or peer of it) it belongs to.
+struct JobOwner {
+  std::size_t run_index = 0;  ///< into BenchResult::runs
+  std::string peer;           ///< empty: the parallax run itself
+  int repeat = 0;
+};
+
+struct JobList {
+  std::vector<ProcessJob> jobs;
+  std::vector<JobOwner> owners;
+};
+
+void AddRuns(const BenchOptions& options, BenchResult* result, JobList* list) {
+  for (const SequenceSpec& s : result->suite.sequences) {
+    const std::size_t first_of_sequence = result->runs.size();
+    for (const Configuration& c : result->suite.configurations) {
+      RunRecord record;
+      record.sequence = s.name;
+      record.configuration = c.name;
+      record.run_dir = (fs::absolute(options.out_dir) / "runs" / s.name / c.name).string();
+      for (int k = 0; k < options.repeat; ++k) {
+        const std::string dir = (fs::path(record.run_dir) / fmt::format("repeat{}", k)).string();
+        list->jobs.push_back(
+            {Pinned(options.cpus, RunArguments(options.parallax_binary, s, c, dir)), dir, s.name});
+        list->owners.push_back({result->runs.size(), "", k});
+      }
+      record.command = Join(list->jobs.back().argv);
+      result->runs.push_back(std::move(record));
+    }
+    // A peer runs once per sequence; its figures go to every configuration's row.
+    for (const PeerProgram& peer : options.peer_programs) {
+      for (int k = 0; k < options.repeat; ++k) {
+        const std::string dir = (fs::absolute(options.out_dir) / "runs" / s.name /
+                                 ("peer-" + peer.name) / fmt::format("repeat{}", k))
+                                    .string();
+        const std::vector<std::string> argv{peer.command, s.path, dir,
+                                            std::to_string(s.max_frames)};
+        list->jobs.push_back({Pinned(options.cpus, argv), dir, s.name + " (" + peer.name + ")"});
+        list->owners.push_back({first_of_sequence, peer.name, k});
+      }
+    }
+  }
+}
+
+/// Peer program results of one sequence, from its jobs' outcomes.
+std::map<std::string, PeerFigures> PeerResults(const JobList& list,
+                                               const std::vector<ProcessOutcome>& outcomes,
+                                               std::size_t run_index, const SequenceSpec& s,
+                                               std::size_t frames) {
+  std::map<std::string, std::vector<double>> walls;
+  std::map<std::string, PeerFigures> peers;
+  for (std::size_t j = 0; j < list.jobs.size(); ++j) {
+    const JobOwner& owner = list.owners[j];
+    if (owner.peer.empty() || owner.run_index != run_index) continue;
+    PeerFigures& p = peers[owner.peer];
+    p.timed = true;
+    if (outcomes[j].exit_code != 0 && p.exit_code == 0) {
+      p.exit_code = outcomes[j].exit_code;
+      p.log_tail = TailOf((fs::path(list.jobs[j].dir) / "run.log").string(), 5);
+    }
+    walls[owner.peer].push_back(outcomes[j].wall_s);
+    if (owner.repeat == 0) {
+      p.figures =
+          EvaluateTrajectory((fs::path(list.jobs[j].dir) / "trajectory.txt").string(), s, nullptr);
+    }
+  }
+  for (auto& [name, p] : peers) {
+    p.ms_per_frame =
+        1e3 * Median(walls[name]) / static_cast<double>(std::max<std::size_t>(1, frames));
+    if (p.exit_code != 0) p.figures.ok = false;
+  }
+  return peers;
+}
+
+}  // namespace
+
 BenchResult RunBench(const std::string& suite_file, const BenchOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   CheckArgument(options.jobs >= 1 && options.repeat >= 1,
@@ -226,36 +230,32 @@ BenchResult RunBench(const std::string& suite_file, const BenchOptions& options)
   BenchResult result;
   result.suite = ReadSuite(suite_file, cache);
   RenderMissing(result.suite, options.progress);
-  std::vector<Job> jobs;
-  for (const SequenceSpec& s : result.suite.sequences) {
-    for (const Configuration& c : result.suite.configurations) {
-      RunRecord record;
-      record.sequence = s.name;
-      record.configuration = c.name;
-      record.run_dir = (fs::absolute(options.out_dir) / "runs" / s.name / c.name).string();
-      for (int k = 0; k < options.repeat; ++k) {
-        const std::string dir = (fs::path(record.run_dir) / fmt::format("repeat{}", k)).string();
-        jobs.push_back(
-            {result.runs.size(), k, RunArguments(options.parallax_binary, s, c, dir), dir});
-      }
-      record.command = Join(jobs.back().argv);
-      result.runs.push_back(std::move(record));
+  JobList list;
+  AddRuns(options, &result, &list);
+  const std::vector<ProcessOutcome> outcomes =
+      RunProcesses(list.jobs, options.jobs, options.progress);
+  std::vector<std::vector<double>> walls(result.runs.size());
+  for (std::size_t j = 0; j < list.jobs.size(); ++j) {
+    const JobOwner& owner = list.owners[j];
+    if (!owner.peer.empty()) continue;
+    RunRecord& r = result.runs[owner.run_index];
+    const int code = outcomes[j].exit_code;
+    if (code != 0 && r.exit_code == 0) {
+      r.exit_code = code;
+      r.log_tail = TailOf((fs::path(list.jobs[j].dir) / "run.log").string(), 5);
     }
-  }
-  const std::vector<int> codes = RunJobs(jobs, options, result.runs);
-  for (std::size_t j = 0; j < jobs.size(); ++j) {
-    RunRecord& r = result.runs[jobs[j].run_index];
-    if (codes[j] != 0 && r.exit_code == 0) {
-      r.exit_code = codes[j];
-      r.log_tail = Tail((fs::path(jobs[j].dir) / "run.log").string(), 5);
-    }
-    if (codes[j] == 0) ReadStats(jobs[j].dir, &r, jobs[j].repeat == 0);
+    if (code == 0) ReadStats(list.jobs[j].dir, &r, owner.repeat == 0);
+    walls[owner.run_index].push_back(outcomes[j].wall_s);
   }
   std::size_t index = 0;
   for (const SequenceSpec& s : result.suite.sequences) {
+    const std::size_t frames = SequenceFrames(s);
+    const std::map<std::string, PeerFigures> timed = PeerResults(list, outcomes, index, s, frames);
     for (std::size_t c = 0; c < result.suite.configurations.size(); ++c, ++index) {
       RunRecord& r = result.runs[index];
       r.fps = Median(r.fps_repeats);
+      r.process_ms_per_frame =
+          1e3 * Median(walls[index]) / static_cast<double>(std::max<std::size_t>(1, frames));
       const std::string first = ReadAll(fs::path(r.run_dir) / "repeat0" / "trajectory.txt");
       for (int k = 1; k < options.repeat && r.exit_code == 0; ++k) {
         const fs::path other = fs::path(r.run_dir) / fmt::format("repeat{}", k) / "trajectory.txt";
@@ -263,7 +263,10 @@ BenchResult RunBench(const std::string& suite_file, const BenchOptions& options)
       }
       const std::string estimate = (fs::path(r.run_dir) / "repeat0" / "trajectory.txt").string();
       if (r.exit_code == 0) r.figures = EvaluateTrajectory(estimate, s, &r.groundtruth);
-      for (const auto& [name, file] : s.peers) r.peers[name] = EvaluateTrajectory(file, s, nullptr);
+      for (const auto& [name, file] : s.peers) {
+        r.peers[name].figures = EvaluateTrajectory(file, s, nullptr);
+      }
+      for (const auto& [name, p] : timed) r.peers[name] = p;
     }
   }
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

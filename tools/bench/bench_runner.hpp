@@ -13,6 +13,14 @@
 
 namespace parallax::bench {
 
+/// Another system run on the same sequences in the same bench run: `command DATASET OUT_DIR
+/// MAX_FRAMES` (MAX_FRAMES 0: all) must write OUT_DIR/trajectory.txt (TUM format) and exit 0.
+/// scripts/peers/ has adapters (docs/benchmarks.md, "Side by side with a peer").
+struct PeerProgram {
+  std::string name;
+  std::string command;
+};
+
 struct BenchOptions {
   std::string out_dir;
   int jobs = 1;
@@ -20,6 +28,10 @@ struct BenchOptions {
   std::string parallax_binary;  ///< the `parallax` executable that runs each sequence
   std::string cache_dir;        ///< rendered sequences; empty: <out_dir>/cache
   bool progress = true;         ///< a progress display on stderr
+  /// Every process (parallax and peers) pinned to these CPUs (taskset list, e.g. "0");
+  /// empty: not pinned. With a peer, use --jobs 1 so that nothing runs beside the timing.
+  std::string cpus;
+  std::vector<PeerProgram> peer_programs;
 };
 
 /// Figures of one trajectory against the ground truth.
@@ -37,6 +49,16 @@ struct TrajectoryFigures {
   std::vector<KittiSegmentError> kitti;
 };
 
+/// A peer on one sequence: a trajectory file named by the suite (figures only), or a program
+/// the harness ran (figures and whole-process time).
+struct PeerFigures {
+  TrajectoryFigures figures;
+  bool timed = false;         ///< run by the harness (PeerProgram)
+  int exit_code = 0;          ///< of the first failing repeat
+  std::string log_tail;       ///< last lines of a failed run's output
+  double ms_per_frame = 0.0;  ///< median whole-process wall time over the repeats / frames
+};
+
 /// One (sequence, configuration) run: medians over the repeats.
 struct RunRecord {
   std::string sequence;
@@ -47,10 +69,13 @@ struct RunRecord {
   int exit_code = 0;        ///< of the first failing repeat, else 0
   std::string log_tail;     ///< last lines of a failed run's output
   TrajectoryFigures figures;
-  std::map<std::string, TrajectoryFigures> peers;
+  std::map<std::string, PeerFigures> peers;
   int frames = 0, frames_tracked = 0, keyframes = 0, loop_closures = 0;
   double fps = 0.0;  ///< median over repeats
   std::vector<double> fps_repeats;
+  /// Median whole-process wall time (start-up and output included) / image frames: the
+  /// figure compared with a timed peer's.
+  double process_ms_per_frame = 0.0;
   double tracking_ms_p50 = 0.0, tracking_ms_p95 = 0.0;
   double mapping_ms_p50 = 0.0, mapping_ms_p95 = 0.0;
   double optimisation_ms_p50 = 0.0, optimisation_ms_p95 = 0.0;

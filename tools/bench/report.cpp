@@ -84,10 +84,32 @@ nlohmann::json Machine() {
           {"compiler", fmt::format("g++ {}.{}.{}", __GNUC__, __GNUC_MINOR__, __GNUC_PATCHLEVEL__)}};
 }
 
-std::string Cell(const TrajectoryFigures& f) {
-  if (!f.ok) return "failed";
-  return fmt::format("{:.4f} m ({:.2f}%), {:.0f}%", f.ate_rmse, f.ate_percent_of_path,
-                     100.0 * f.coverage);
+std::string Cell(const RunRecord& r, const PeerFigures& p) {
+  const TrajectoryFigures& f = p.figures;
+  std::string cell = p.exit_code != 0 ? fmt::format("failed (exit {})", p.exit_code)
+                     : !f.ok          ? std::string("failed")
+                                      : fmt::format("{:.4f} m ({:.2f}%), {:.0f}%", f.ate_rmse,
+                                                    f.ate_percent_of_path, 100.0 * f.coverage);
+  if (p.timed) {
+    cell += fmt::format(", {:.1f} ms/frame", p.ms_per_frame);
+    if (r.Ok() && p.ms_per_frame > 0.0) {
+      cell += fmt::format(" (parallax {:.2f}x its time)", r.process_ms_per_frame / p.ms_per_frame);
+    }
+  }
+  return cell;
+}
+
+nlohmann::json PeerJson(const RunRecord& r, const PeerFigures& p) {
+  nlohmann::json j = FiguresJson(p.figures);
+  if (!p.timed) return j;
+  j["ms_per_frame"] = p.ms_per_frame;
+  j["exit_code"] = p.exit_code;
+  if (!p.log_tail.empty()) j["log_tail"] = p.log_tail;
+  // Whole-process time per frame, parallax over the peer (below 1: parallax is faster).
+  j["time_ratio"] = p.ms_per_frame > 0.0 && r.Ok()
+                        ? nlohmann::json(r.process_ms_per_frame / p.ms_per_frame)
+                        : nlohmann::json();
+  return j;
 }
 
 }  // namespace
@@ -112,6 +134,7 @@ std::string ReportJson(const BenchResult& result, const std::string& invocation)
         {"loop_closures", r.loop_closures},
         {"fps", r.fps},
         {"fps_repeats", r.fps_repeats},
+        {"process_ms_per_frame", r.process_ms_per_frame},
         {"tracking_ms", {{"p50", r.tracking_ms_p50}, {"p95", r.tracking_ms_p95}}},
         {"mapping_ms", {{"p50", r.mapping_ms_p50}, {"p95", r.mapping_ms_p95}}},
         {"optimisation_ms", {{"p50", r.optimisation_ms_p50}, {"p95", r.optimisation_ms_p95}}},
@@ -119,7 +142,7 @@ std::string ReportJson(const BenchResult& result, const std::string& invocation)
         {"repeats_identical", r.repeats_identical}};
     if (!r.log_tail.empty()) run["log_tail"] = r.log_tail;
     nlohmann::json peers = nlohmann::json::object();
-    for (const auto& [name, f] : r.peers) peers[name] = FiguresJson(f);
+    for (const auto& [name, p] : r.peers) peers[name] = PeerJson(r, p);
     run["peers"] = peers;
     runs.push_back(run);
   }
@@ -155,7 +178,7 @@ std::string ReportJson(const BenchResult& result, const std::string& invocation)
 std::string ReportMarkdown(const BenchResult& result) {
   std::vector<std::string> peer_names;
   for (const RunRecord& r : result.runs) {
-    for (const auto& [name, f] : r.peers) {
+    for (const auto& [name, p] : r.peers) {
       if (std::find(peer_names.begin(), peer_names.end(), name) == peer_names.end()) {
         peer_names.push_back(name);
       }
@@ -167,28 +190,29 @@ std::string ReportMarkdown(const BenchResult& result) {
       "coverage = share of image frames with a pose; X = coverage below 90%.\n\n",
       result.suite.name, Commit(), result.runs.size(), result.wall_s);
   md += std::string("| sequence |") + (configs ? " configuration |" : "") +
-        " ATE RMSE (Sim3) | % of path | ATE (SE3) | frames posed | keyframes | fps | tracking ms "
-        "p50/p95 | mapping ms p50/p95 | peak RSS |";
+        " ATE RMSE (Sim3) | % of path | ATE (SE3) | frames posed | keyframes | fps | process "
+        "ms/frame | tracking ms p50/p95 | mapping ms p50/p95 | peak RSS |";
   for (const std::string& p : peer_names) md += " " + p + " |";
-  md += "\n|---|" + std::string(configs ? "---|" : "") + "---|---|---|---|---|---|---|---|---|";
+  md += "\n|---|" + std::string(configs ? "---|" : "") + "---|---|---|---|---|---|---|---|---|---|";
   for (std::size_t k = 0; k < peer_names.size(); ++k) md += "---|";
   md += "\n";
   for (const RunRecord& r : result.runs) {
     md += "| " + r.sequence + " |" + (configs ? " " + r.configuration + " |" : "");
     if (!r.Ok()) {
-      md += fmt::format(" failed (exit {}) | | | | | | | | |", r.exit_code);
+      md += fmt::format(" failed (exit {}) | | | | | | | | | |", r.exit_code);
     } else {
       const TrajectoryFigures& f = r.figures;
       md += fmt::format(
-          " {:.4f} m | {:.2f}% | {:.4f} m | {}/{} ({:.0f}%){} | {} | {:.1f} | {:.1f} / {:.1f} | "
-          "{:.1f} / {:.1f} | {:.0f} MB |",
+          " {:.4f} m | {:.2f}% | {:.4f} m | {}/{} ({:.0f}%){} | {} | {:.1f} | {:.1f} | {:.1f} / "
+          "{:.1f} | {:.1f} / {:.1f} | {:.0f} MB |",
           f.ate_rmse, f.ate_percent_of_path, f.ate_rmse_se3, r.frames_tracked, r.frames,
-          100.0 * f.coverage, f.coverage < 0.9 ? " X" : "", r.keyframes, r.fps, r.tracking_ms_p50,
-          r.tracking_ms_p95, r.mapping_ms_p50, r.mapping_ms_p95, r.peak_rss_mb);
+          100.0 * f.coverage, f.coverage < 0.9 ? " X" : "", r.keyframes, r.fps,
+          r.process_ms_per_frame, r.tracking_ms_p50, r.tracking_ms_p95, r.mapping_ms_p50,
+          r.mapping_ms_p95, r.peak_rss_mb);
     }
     for (const std::string& p : peer_names) {
       const auto it = r.peers.find(p);
-      md += " " + (it == r.peers.end() ? std::string("-") : Cell(it->second)) + " |";
+      md += " " + (it == r.peers.end() ? std::string("-") : Cell(r, it->second)) + " |";
     }
     md += "\n";
   }

@@ -89,12 +89,31 @@ void AddBenchCommand(CLI::App& app, int* exit_code) {
   cmd->add_option("--cache", args->options.cache_dir,
                   "folder for rendered sequences (default: <out>/cache)");
   cmd->add_flag("--no-plots", args->no_plots, "skip the PNG plots");
+  cmd->add_option("--cpus", args->options.cpus,
+                  "pin every run (parallax and peers) to these CPUs, taskset syntax, e.g. 0");
+  cmd->add_option_function<std::vector<std::string>>(
+      "--peer",
+      [args](const std::vector<std::string>& peers) {
+        for (const std::string& p : peers) {
+          const std::size_t eq = p.find('=');
+          if (eq == std::string::npos || eq == 0 || eq + 1 == p.size()) {
+            throw CLI::ValidationError("--peer", "expected NAME=COMMAND, got '" + p + "'");
+          }
+          args->options.peer_programs.push_back({p.substr(0, eq), p.substr(eq + 1)});
+        }
+      },
+      "NAME=COMMAND: also run COMMAND DATASET OUT_DIR MAX_FRAMES on every sequence (it writes "
+      "OUT_DIR/trajectory.txt) and compare time per frame (docs/benchmarks.md)");
   cmd->callback([args, exit_code, cmd] {
     std::string invocation = "parallax bench";
     for (const std::string& a : cmd->remaining(true)) invocation += " " + a;
     invocation += " " + args->suite + " --out " + args->options.out_dir +
                   fmt::format(" --jobs {} --repeat {}", args->options.jobs, args->options.repeat) +
-                  (args->baseline.empty() ? "" : " --baseline " + args->baseline);
+                  (args->baseline.empty() ? "" : " --baseline " + args->baseline) +
+                  (args->options.cpus.empty() ? "" : " --cpus " + args->options.cpus);
+    for (const bench::PeerProgram& p : args->options.peer_programs) {
+      invocation += " --peer " + p.name + "=" + p.command;
+    }
     *exit_code = RunBenchCommand(*args, invocation);
   });
 }
