@@ -18,6 +18,7 @@ int Run(int argc, char** argv) {
   parallax::cli::AddBenchCommand(app, &exit_code);
   parallax::cli::AddDemoCommand(app, &exit_code);
   parallax::cli::AddEvalCommand(app, &exit_code);
+  parallax::cli::AddFramesCommand(app, &exit_code);
   parallax::cli::AddInfoCommand(app, &exit_code);
   parallax::cli::AddPosegraphCommand(app, &exit_code);
   parallax::cli::AddRunCommand(app, &exit_code);

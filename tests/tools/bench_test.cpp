@@ -168,7 +168,12 @@ TEST(BenchRunner, PeerProgramsAreRunTimedAndEvaluated) {
                 "#!/bin/sh\nsleep 0.4\nmkdir -p \"$2\"\necho \"$3\" > \"$2/max_frames\"\n"
                 "cp \"$1/groundtruth.txt\" \"$2/trajectory.txt\"\n");
   const std::string broken = dir.Write("broken.sh", "#!/bin/sh\necho no input >&2\nexit 3\n");
-  for (const std::string& f : {truth, broken}) {
+  // "timer" times its own system: 3 s, whatever its whole process took.
+  const std::string timer =
+      dir.Write("timer.sh",
+                "#!/bin/sh\ncp \"$1/groundtruth.txt\" \"$2/trajectory.txt\"\necho 3.0 > "
+                "\"$2/wall_seconds\"\n");
+  for (const std::string& f : {truth, broken, timer}) {
     std::filesystem::permissions(f, std::filesystem::perms::owner_exec,
                                  std::filesystem::perm_options::add);
   }
@@ -177,7 +182,7 @@ TEST(BenchRunner, PeerProgramsAreRunTimedAndEvaluated) {
       "motion: shake, frames: 40, width: 320, height: 240}\n";
   BenchOptions options = Options(dir, "p", 1);
   options.cpus = "0";
-  options.peer_programs = {{"truth", truth}, {"broken", broken}};
+  options.peer_programs = {{"truth", truth}, {"broken", broken}, {"timer", timer}};
   const BenchResult r = RunBench(dir.Write("peers.yaml", suite), options);
   ASSERT_EQ(r.runs.size(), 1u);
   ASSERT_TRUE(r.runs[0].Ok());
@@ -192,6 +197,7 @@ TEST(BenchRunner, PeerProgramsAreRunTimedAndEvaluated) {
   int n = 0;
   max_frames >> n;
   EXPECT_EQ(n, 30);
+  EXPECT_DOUBLE_EQ(r.runs[0].peers.at("timer").ms_per_frame, 3000.0 / 30.0);
   const PeerFigures& bad = r.runs[0].peers.at("broken");
   EXPECT_EQ(bad.exit_code, 3);
   EXPECT_FALSE(bad.figures.ok);

@@ -203,7 +203,12 @@ std::map<std::string, PeerFigures> PeerResults(const JobList& list,
       p.exit_code = outcomes[j].exit_code;
       p.log_tail = TailOf((fs::path(list.jobs[j].dir) / "run.log").string(), 5);
     }
-    walls[owner.peer].push_back(outcomes[j].wall_s);
+    // A peer that prepares its input first reports the time of its own process.
+    double wall = outcomes[j].wall_s;
+    if (std::ifstream reported(fs::path(list.jobs[j].dir) / "wall_seconds"); reported) {
+      reported >> wall;
+    }
+    walls[owner.peer].push_back(wall);
     if (owner.repeat == 0) {
       p.figures =
           EvaluateTrajectory((fs::path(list.jobs[j].dir) / "trajectory.txt").string(), s, nullptr);

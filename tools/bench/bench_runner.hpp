@@ -15,6 +15,8 @@ namespace parallax::bench {
 
 /// Another system run on the same sequences in the same bench run: `command DATASET OUT_DIR
 /// MAX_FRAMES` (MAX_FRAMES 0: all) must write OUT_DIR/trajectory.txt (TUM format) and exit 0.
+/// It is timed as a whole process unless it writes OUT_DIR/wall_seconds (e.g. an adapter
+/// that converts the input first and times only the system it runs).
 /// scripts/peers/ has adapters (docs/benchmarks.md, "Side by side with a peer").
 struct PeerProgram {
   std::string name;
