@@ -47,6 +47,7 @@ struct LiveTracker {
   std::int64_t keyframe_request_frame = -1;  ///< ... that frame's id
   std::int64_t waited_for_keyframe = 0;      ///< frames that waited for a requested keyframe
   std::int64_t tracked_live = 0;
+  bool previous_lost = false;  ///< the caller's previous frame got no pose
   std::int64_t mapped_waiting = 0;
   /// The mapping thread's: the keyframe of its last snapshot, and the one before it.
   std::int64_t published_keyframe_id = -1;

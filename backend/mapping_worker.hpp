@@ -43,6 +43,9 @@ struct MappingJob {
   /// A frame the live tracker lost: its motion state after its last good frame, which is
   /// newer than the mapping thread's when mapping skipped frames (keyframe_id -1: none).
   LiveTracking hint;
+  /// The caller's previous frame got no pose (System: a "poor" tracking right after a loss
+  /// is not trusted).
+  bool previous_lost = false;
 };
 
 class MappingWorker {

@@ -171,9 +171,18 @@ FrameResult System::ProcessFrame(const ImageU8& image, double timestamp) {
     result.events.push_back({SystemEvent::Kind::kLost, id, -1});
     Record(id, result);
     TakePendingEvents(&result);
+    if (live_) {
+      live_->previous_lost = true;
+    } else {
+      previous_frame_lost_ = true;
+    }
     return result;
   }
-  if (live_) return ProcessLive(id, timestamp, image);
+  if (live_) {
+    FrameResult result = ProcessLive(id, timestamp, image);
+    live_->previous_lost = !result.T_w_c;
+    return result;
+  }
   auto frame = std::make_shared<const Frame>(id, timestamp, camera_, image, options_.pyramid);
   const std::lock_guard<std::mutex> lock(engine_mutex_);
   return ProcessInOrder(frame, image);
@@ -188,6 +197,7 @@ FrameResult System::ProcessInOrder(const std::shared_ptr<const Frame>& frame,
     result.events.push_back({SystemEvent::Kind::kPosesRevised, frame->Id(), -1});
   }
   if (result.T_w_c) last_posed_timestamp_ = frame->Timestamp();
+  previous_frame_lost_ = !result.T_w_c;
   result.initialising = start_ != StartState::kInitialised && start_ != StartState::kRelocalising;
   Record(frame->Id(), result);
   return result;
@@ -230,6 +240,7 @@ FrameResult System::Process(const std::shared_ptr<const Frame>& frame, const Ima
 TrackingResult System::TrackFrame(const Frame& frame, FrameResult* result) {
   const auto start = Clock::now();
   TrackingResult tracked;
+  const MotionState before = tracker_.State();
   try {
     tracked = tracker_.Track(*mapper_.Reference(), frame);
   } catch (const NumericalDivergence& e) {
@@ -239,6 +250,14 @@ TrackingResult System::TrackFrame(const Frame& frame, FrameResult* result) {
     result->events.push_back({SystemEvent::Kind::kDiverged, frame.Id(), current_.id});
   }
   result->tracking_ms = MillisecondsSince(start);
+  if (tracked.status == TrackingStatus::kPoor && previous_frame_lost_ &&
+      start_ == StartState::kInitialised) {
+    // Just below the lost threshold for a run of frames, then just above it, is the same
+    // wrong alignment, not a re-acquisition (a 29 degree error was accepted that way).
+    tracked.status = TrackingStatus::kLost;
+    tracked.stats.reason = "poor right after a lost frame (re-acquisition needs ok)";
+    tracker_.SetState(before);
+  }
   result->status = tracked.status;
   result->stats = tracked.stats;
   if (tracked.status == TrackingStatus::kLost) return tracked;  // the last good state is kept

@@ -555,6 +555,9 @@ class System {
   /// Timestamp of the last frame that got a pose (long-loss timer; on a loaded map, of the
   /// first frame given to it).
   double last_posed_timestamp_ = 0.0;
+  /// The previous frame got no pose: a frame tracked only "poor" against the same keyframe
+  /// is then not trusted (re-acquisition needs an ok match, as recovery does).
+  bool previous_frame_lost_ = false;
   std::unique_ptr<TwoViewBootstrap> bootstrap_;  ///< set while a two-view pair is sought
   int bootstrap_tries_ = 0;
   /// Auto: the first good pair, held until the random start has converged (or failed) and

@@ -108,7 +108,7 @@ void System::TakePendingEvents(FrameResult* result) {
 
 FrameResult System::WaitForMapping(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
                                    std::optional<LiveTracking> live, LiveTracking hint) {
-  MappingJob job{frame, image, std::move(live), true, false, std::move(hint)};
+  MappingJob job{frame, image, std::move(live), true, false, std::move(hint), live_->previous_lost};
   FrameResult result = worker_->Run(std::move(job));
   ++live_->mapped_waiting;
   live_->Adopt(live_->Latest());
@@ -126,6 +126,13 @@ FrameResult System::ProcessLive(std::int64_t id, double timestamp, const ImageU8
   live_->Follow(snapshot);
   const MotionState before = live_->tracker.State();
   LiveStep step = TrackLive(*frame, snapshot);
+  if (step.tracked.status == TrackingStatus::kPoor && live_->previous_lost) {
+    // As System::TrackFrame: right after a loss only an ok match re-acquires.
+    live_->tracker.SetState(before);
+    step.tracked.status = TrackingStatus::kLost;
+    step.overdue = false;
+    step.keep = false;
+  }
   if (step.overdue && live_->keyframe_request_frame >= 0) {
     // The keyframe this one needs was asked for by an earlier frame: wait until mapping
     // has made it (only that job, not the refinements or the backend behind it), then
@@ -215,7 +222,8 @@ FrameResult System::AnswerLive(const std::shared_ptr<const Frame>& frame, const 
   Record(frame->Id(), result);
   LiveTracking live{snapshot.keyframe_id, step.tracked, live_->tracker.State(),
                     snapshot.generation};
-  worker_->Offer(MappingJob{frame, image, std::move(live), false, step.keep, LiveTracking{}},
+  worker_->Offer(MappingJob{frame, image, std::move(live), false, step.keep, LiveTracking{},
+                            live_->previous_lost},
                  !snapshot.initialised);
   ++live_->tracked_live;
   TakePendingEvents(&result);
@@ -238,12 +246,14 @@ FrameResult System::MapJob(const MappingJob& job) {
     SetPose(&result, job.live->tracked.T_kf_frame);
     MapFrame(job.frame, job.image, job.live->tracked, &result);
     last_posed_timestamp_ = job.frame->Timestamp();
+    previous_frame_lost_ = false;
     Record(job.frame->Id(), result);
   } else {
     if (job.hint.keyframe_id >= 0 && job.hint.keyframe_id == current_.id &&
         job.hint.generation == map_generation_ && start_ == StartState::kInitialised) {
       tracker_.SetState(job.hint.motion);
     }
+    previous_frame_lost_ = job.previous_lost;
     result = ProcessInOrder(job.frame, job.image);
     // A frame the caller already has a pose for keeps it when tracking it again here failed.
     if (!result.T_w_c && job.live && !job.caller_waits) {

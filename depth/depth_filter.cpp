@@ -8,6 +8,7 @@
 
 #include "core/check.hpp"
 #include "core/divergence.hpp"
+#include "depth/regularize_kernel.hpp"
 
 namespace parallax {
 namespace {
@@ -184,25 +185,32 @@ DepthUpdateStats DepthFilter::Update(InverseDepthMap* map, const StereoFrame& fr
 
 int DepthFilter::Regularize(InverseDepthMap* map) const {
   const int w = map->Width(), h = map->Height();
-  // Inverse variances once per pixel (0 for invalid ones), and the distance decay as a table:
-  // the 5x5 loop below is then multiplications only.
-  std::vector<float> inv_var(map->valid.size(), 0.0f);
+  // The kernel's inputs once per pixel (0 for invalid ones), and the distance decay as a
+  // table: the 5x5 window is then multiplications and masks only.
+  RegularizeInputs in;
+  in.width = w;
+  in.idepth = map->idepth.data();
+  in.variance = map->variance.data();
+  in.inv_var.assign(map->valid.size(), 0.0f);
+  in.support.assign(map->valid.size(), 0.0f);
+  in.vote.assign(map->valid.size(), 0.0f);
   int diverged = 0;
-  for (std::size_t i = 0; i < inv_var.size(); ++i) {
+  for (std::size_t i = 0; i < map->valid.size(); ++i) {
     if (!map->valid[i]) continue;
     if (!HealthyEstimate(map->idepth[i], map->variance[i])) {
       Invalidate(map, i);
       ++diverged;
       continue;
     }
-    inv_var[i] = 1.0f / map->variance[i];
+    in.inv_var[i] = 1.0f / map->variance[i];
+    in.support[i] = map->validity[i];
+    in.vote[i] = map->observations[i] > 0 ? map->validity[i] : 0.0f;
   }
   // Inverse variance, decaying mildly with distance (scale-free form of LSD's
   // 1 / (var + dist^2 * REG_DIST_VAR)).
-  std::array<float, 25> decay{};
   for (int dy = -2; dy <= 2; ++dy) {
     for (int dx = -2; dx <= 2; ++dx)
-      decay[Idx((dy + 2) * 5 + dx + 2)] =
+      in.decay[Idx((dy + 2) * 5 + dx + 2)] =
           1.0f / (1.0f + 0.1f * static_cast<float>(dx * dx + dy * dy));
   }
   std::vector<std::uint8_t> keep(map->valid.size(), 0);
@@ -212,45 +220,19 @@ int DepthFilter::Regularize(InverseDepthMap* map) const {
     for (int x = 2; x < w - 2; ++x) {
       const std::size_t i = map->Index(x, y);
       if (!map->valid[i]) continue;
-      RegularizePixel(map, inv_var, decay, x, y, &keep[i]);
+      const RegularizedPixel r = RegularizePixelSimd(in, i);
+      map->idepth_smoothed[i] = r.idepth;
+      map->variance_smoothed[i] = r.variance;
+      // Removed: too little support around it, or observed neighbours mostly disagree (a
+      // wrong match that later observations within its own mu +- 2 sigma cannot correct).
+      keep[i] = r.support >= options_.min_neighbour_validity && !(r.disagree > r.agree) &&
+                HealthyEstimate(r.idepth, r.variance);
     }
   });
   for (std::size_t i = 0; i < keep.size(); ++i) {
     if (map->valid[i] && !keep[i]) Invalidate(map, i);
   }
   return diverged;
-}
-
-void DepthFilter::RegularizePixel(InverseDepthMap* map_ptr, const std::vector<float>& inv_var,
-                                  const std::array<float, 25>& decay, int x, int y,
-                                  std::uint8_t* keep) const {
-  InverseDepthMap& map = *map_ptr;
-  const std::size_t i = map.Index(x, y);
-  const float d_i = map.idepth[i], var_i = map.variance[i];
-  float sum_w = 0.0f, sum_wd = 0.0f, support = 0.0f, agree = 0.0f, disagree = 0.0f;
-  for (int dy = -2; dy <= 2; ++dy) {
-    const std::size_t row = map.Index(x - 2, y + dy);
-    const float* decay_row = &decay[Idx((dy + 2) * 5)];
-    for (int k = 0; k < 5; ++k) {
-      const std::size_t j = row + Idx(k);
-      if (!map.valid[j]) continue;
-      support += map.validity[j];
-      const float diff = map.idepth[j] - d_i;
-      const bool compatible = diff * diff <= var_i + map.variance[j];
-      // Observed neighbours vote on whether this estimate is an outlier.
-      if (j != i && map.observations[j] > 0) (compatible ? agree : disagree) += map.validity[j];
-      if (!compatible) continue;
-      const float weight = inv_var[j] * decay_row[k];
-      sum_w += weight;
-      sum_wd += weight * map.idepth[j];
-    }
-  }
-  map.idepth_smoothed[i] = sum_wd / sum_w;
-  map.variance_smoothed[i] = std::min(var_i, 1.0f / sum_w);
-  // Removed: too little support around it, or observed neighbours mostly disagree (a wrong
-  // match that later observations within its own mu +- 2 sigma cannot correct).
-  *keep = support >= options_.min_neighbour_validity && !(disagree > agree) &&
-          HealthyEstimate(map.idepth_smoothed[i], map.variance_smoothed[i]);
 }
 
 int DepthFilter::FillHoles(InverseDepthMap* map) const {

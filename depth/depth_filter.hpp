@@ -79,9 +79,6 @@ class DepthFilter {
  private:
   void UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search, int x, int y,
                    DepthUpdateStats* stats) const;
-  /// Smooths valid pixel (x, y) over its 5x5 neighbourhood; `keep` = 0 when it is an outlier.
-  void RegularizePixel(InverseDepthMap* map, const std::vector<float>& inv_var,
-                       const std::array<float, 25>& decay, int x, int y, std::uint8_t* keep) const;
   /// Standard deviation below converged_relative_sigma of the inverse depth.
   bool Converged(const InverseDepthMap& map, std::size_t i) const;
   DepthFilterOptions options_;

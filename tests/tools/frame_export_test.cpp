@@ -46,7 +46,9 @@ void ExpectExportMatchesTheEngineInput(const std::string& dataset, const std::st
     double t = 0.0;
     times >> name >> t;
     EXPECT_NEAR(t, frame->timestamp, 1e-6);
-    const cv::Mat written = cv::imread(out + "/images/" + name + ".png", cv::IMREAD_UNCHANGED);
+    std::string file = out;
+    file += "/images/" + name;
+    const cv::Mat written = cv::imread(file + ".png", cv::IMREAD_UNCHANGED);
     const ImageU8 expected = undistorter.Apply(frame->image);
     ASSERT_EQ(written.cols, expected.Width());
     ASSERT_EQ(written.rows, expected.Height());
