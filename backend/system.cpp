@@ -24,6 +24,8 @@ void SystemOptions::Check() const {
   tracker.Check();
   depth.Check();
   update_direction.Check();
+  start_refinement.Check();
+  CheckOption(start_refinement_frames >= 2, "SystemOptions", "start_refinement_frames", ">= 2");
   bootstrap.Check();
   quality.Check();
   backend.Check();

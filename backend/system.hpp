@@ -16,6 +16,7 @@
 #include "backend/frame_tracker.hpp"
 #include "backend/graph_backend.hpp"
 #include "backend/keyframe_graph.hpp"
+#include "backend/keyframe_refinement.hpp"
 #include "backend/loop_closer.hpp"
 #include "backend/mapper.hpp"
 #include "backend/place_recognizer.hpp"
@@ -134,6 +135,13 @@ struct SystemOptions {
   /// frames/s; 30 before) makes the start's one-off comparison a third cheaper: 90-frame
   /// renders 9-13% faster end to end, TUM 5.6 -> 5.9 mm, renders unchanged within noise.
   int initialization_updates = 20;
+  /// When initialisation completes, the first keyframe's depth and the buffered frames'
+  /// poses are refined jointly (docs/math/keyframe_refinement.md): the depth filter's
+  /// alternation leaves a smooth distortion (a tilt) that joint refinement removes.
+  KeyframeRefinementOptions start_refinement;
+  /// ... on at most this many of the buffered frames (spread, the last included); all are
+  /// then tracked again against the refined depth.
+  int start_refinement_frames = 10;
   /// At most this many frames are kept for re-tracking before initialisation completes (a
   /// static start would otherwise keep them all); older ones keep their first pose.
   int max_buffered_frames = 60;
@@ -472,6 +480,12 @@ class System {
   /// Tracks the buffered frames in order against the current map, updating its depth from
   /// each (as the random start did with its own poses).
   void RefineWithBufferedFrames();
+  /// Joint refinement of the first keyframe and the buffered frames (their poses updated).
+  void RefineStart(BufferedPoses* poses);
+  /// Writes raw and smoothed inverse depths of the current map's `pixel`s and publishes it.
+  void SetEstimates(const std::vector<std::int32_t>& pixel, const std::vector<float>& raw,
+                    const std::vector<float>& smoothed);
+
   /// Builds the pair's start refined by the buffered frames and keeps whichever start has
   /// the lower BufferedResidual; returns the buffered frames' poses tracked against the kept
   /// one (its scoring already tracked them all).

@@ -1,0 +1,199 @@
+// Joint refinement of a keyframe's depth and its frames' poses, on rendered frames with known
+// depth and motion: a tilted depth and perturbed poses are pulled back to the truth.
+
+#include "backend/keyframe_refinement.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "tests/tools/temp_dir.hpp"
+#include "tools/dataset/trajectory.hpp"
+#include "tools/eval/evaluation.hpp"
+#include "tools/run_pipeline.hpp"
+#include "tools/synth/synthetic_sequence.hpp"
+
+namespace parallax {
+namespace {
+
+double Median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+/// Median |log(idepth / truth) - its median|: the depth's shape error, scale removed.
+double ShapeError(const std::vector<float>& idepth, const std::vector<float>& truth) {
+  std::vector<double> log_ratio;
+  for (std::size_t i = 0; i < idepth.size(); ++i)
+    log_ratio.push_back(std::log(idepth[i] / truth[i]));
+  const double m = Median(log_ratio);
+  for (double& l : log_ratio) l = std::abs(l - m);
+  return Median(log_ratio);
+}
+
+/// Slope of log(idepth / truth) over the normalised image row y: the tilt.
+double Tilt(const std::vector<float>& idepth, const std::vector<float>& truth,
+            const std::vector<std::int32_t>& pixel, const PinholeCamera& camera) {
+  double n = 0, sy = 0, sl = 0, syy = 0, syl = 0;
+  for (std::size_t i = 0; i < idepth.size(); ++i) {
+    const int row = pixel[i] / camera.Width();
+    const double y = (row - camera.Cy()) / camera.Fy();
+    const double l = std::log(idepth[i] / truth[i]);
+    n += 1;
+    sy += y;
+    sl += l;
+    syy += y * y;
+    syl += y * l;
+  }
+  return (n * syl - sy * sl) / (n * syy - sy * sy);
+}
+
+double RotationErrorDeg(const SE3d& a, const SE3d& b) {
+  return (a.Rotation().Inverse() * b.Rotation()).Log().norm() * 180.0 / M_PI;
+}
+
+/// Angle between the translation directions (the scale is the gauge's).
+double DirectionErrorDeg(const SE3d& a, const SE3d& b) {
+  const double c = a.Translation().normalized().dot(b.Translation().normalized());
+  return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+/// Pixels next to a depth discontinuity mix two surfaces' grey levels: no single depth
+/// explains them in other views, so the truth is not their optimum.
+bool NearADepthEdge(const ImageF& depth, int x, int y) {
+  for (int dy = -2; dy <= 2; ++dy) {
+    for (int dx = -2; dx <= 2; ++dx) {
+      if (std::abs(depth(x + dx, y + dy) - depth(x, y)) > 0.02f * depth(x, y)) return true;
+    }
+  }
+  return false;
+}
+
+class KeyframeRefinementTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    options_.scene = "room";
+    options_.motion = "orbit";
+    options_.frames = 90;
+    scene_ = synth::MakeScene(options_.scene, options_.seed);
+    camera_ = synth::SynthCamera(options_);
+    const synth::SynthFrame first = synth::RenderSynthFrame(options_, scene_, 0);
+    keyframe_ = std::make_unique<Frame>(0, 0.0, camera_, first.image);
+    const SE3d T_w_kf = synth::FramePose(options_, scene_, 0);
+    const ImageF& max_gradient = keyframe_->MaxGradient();
+    for (int y = 8; y < camera_.Height() - 8; y += 2) {
+      for (int x = 8; x < camera_.Width() - 8; x += 2) {
+        const float z = first.depth(x, y);
+        if (!(z > 0.0f) || max_gradient(x, y) < 8.0f || NearADepthEdge(first.depth, x, y)) continue;
+        pixel_.push_back(y * camera_.Width() + x);
+        truth_.push_back(1.0f / z);
+      }
+    }
+    for (int i = 2; i <= 24; i += 2) {
+      const synth::SynthFrame f = synth::RenderSynthFrame(options_, scene_, i);
+      frames_.push_back(std::make_unique<Frame>(i, 0.0, camera_, f.image));
+      poses_.push_back(T_w_kf.Inverse() * synth::FramePose(options_, scene_, i));
+    }
+  }
+
+  synth::SynthOptions options_;
+  synth::Scene scene_;
+  PinholeCamera camera_{640, 480, 525, 525, 319.5, 239.5};
+  std::unique_ptr<Frame> keyframe_;
+  std::vector<std::unique_ptr<Frame>> frames_;
+  std::vector<SE3d> poses_;  // true T_kf_frame
+  std::vector<std::int32_t> pixel_;
+  std::vector<float> truth_;
+};
+
+/// Largest rotation and translation-direction errors of refined poses, degrees.
+std::pair<double, double> PoseErrors(const std::vector<SE3d>& poses,
+                                     const std::vector<SE3d>& truth) {
+  double rotation = 0.0, direction = 0.0;
+  for (std::size_t j = 0; j < poses.size(); ++j) {
+    rotation = std::max(rotation, RotationErrorDeg(poses[j], truth[j]));
+    direction = std::max(direction, DirectionErrorDeg(poses[j], truth[j]));
+  }
+  return {rotation, direction};
+}
+
+TEST_F(KeyframeRefinementTest, ReducesATiltAndThePoseErrorsThatFitIt) {
+  // The distortion the depth filter's alternation leaves on sideways motion: inverse depth
+  // tilted along the image's vertical axis (+-9%), with poses perturbed by up to 0.6 degrees.
+  std::vector<float> tilted;
+  for (std::size_t i = 0; i < pixel_.size(); ++i) {
+    const int row = pixel_[i] / camera_.Width();
+    const double y = (row - camera_.Cy()) / camera_.Fy();
+    tilted.push_back(static_cast<float>(truth_[i] * std::exp(0.2 * y)));
+  }
+  std::vector<RefinementFrame> frames;
+  std::vector<SE3d> start;
+  for (std::size_t j = 0; j < frames_.size(); ++j) {
+    SE3d::Tangent xi;
+    xi << 0.004, -0.003, 0.002, 0.003, -0.004, 0.002;
+    frames.push_back(
+        {frames_[j].get(), SE3d::Exp(xi * static_cast<double>(j + 1) / 6.0) * poses_[j]});
+    start.push_back(frames.back().T_kf_frame);
+  }
+  const KeyframeRefinementResult r =
+      RefineKeyframe(*keyframe_, pixel_, tilted, frames, KeyframeRefinementOptions{});
+  const double tilt_before = Tilt(tilted, truth_, pixel_, camera_);
+  const double tilt_after = Tilt(r.idepth, truth_, pixel_, camera_);
+  const auto [rotation_before, direction_before] = PoseErrors(start, poses_);
+  const auto [rotation_after, direction_after] = PoseErrors(r.T_kf_frame, poses_);
+  // The tilt is weakly observable over a short window (a near-gauge direction: the poses
+  // can rotate to fit it), so it is reduced, not removed (docs/math/keyframe_refinement.md).
+  EXPECT_LT(r.final_cost, 0.75 * r.initial_cost);
+  EXPECT_LT(tilt_after, 0.95 * tilt_before);
+  EXPECT_LT(rotation_after, rotation_before);
+  EXPECT_LT(direction_after, 2.0);
+  EXPECT_GT(r.points_refined, static_cast<int>(pixel_.size() * 8 / 10));
+}
+
+// On this render the photometric optimum lies 0.2-0.3 degrees from the true poses (with
+// points at depth edges excluded; docs/math/keyframe_refinement.md): the bound says that,
+// and a sign or Jacobian error would move far beyond it.
+TEST_F(KeyframeRefinementTest, StaysNearTheTruth) {
+  std::vector<RefinementFrame> frames;
+  for (std::size_t j = 0; j < frames_.size(); ++j) frames.push_back({frames_[j].get(), poses_[j]});
+  const KeyframeRefinementResult r =
+      RefineKeyframe(*keyframe_, pixel_, truth_, frames, KeyframeRefinementOptions{});
+  const auto [rotation, direction] = PoseErrors(r.T_kf_frame, poses_);
+  EXPECT_LT(rotation, 0.5);
+  EXPECT_LT(direction, 1.0);
+  EXPECT_LT(std::abs(Tilt(r.idepth, truth_, pixel_, camera_)), 0.02);
+  EXPECT_LT(ShapeError(r.idepth, truth_), 0.01);
+}
+
+double RunAtePercent(const std::string& dataset, const std::string& out, bool refine) {
+  RunOptions run;
+  run.dataset = dataset;
+  run.out_dir = out;
+  run.system.start_refinement.enabled = refine;
+  RunDataset(run);
+  return Evaluate(ReadTumTrajectory(out + "/trajectory.txt"),
+                  ReadTumTrajectory(dataset + "/groundtruth.txt"), {})
+      .ate_rmse_percent_of_path;
+}
+
+TEST(StartRefinement, ImprovesAHandHeldStart) {
+  // Seed 3, the judging set's hand-held room (docs/benchmarks.md, "Start refinement"). Seed 2
+  // is not improved: its start is replaced by the two-view pair, a path the refinement does
+  // not take yet (0.288% either way).
+  const test::TempDirAt dir("parallax_start_refinement");
+  synth::SynthOptions options;
+  options.scene = "room";
+  options.motion = "shake";
+  options.frames = 90;
+  options.seed = 3;
+  synth::WriteSyntheticSequence(options, dir.File("seq"));
+  const double off = RunAtePercent(dir.File("seq"), dir.File("off"), false);
+  const double on = RunAtePercent(dir.File("seq"), dir.File("on"), true);
+  RecordProperty("ate_percent_off", std::to_string(off));
+  RecordProperty("ate_percent_on", std::to_string(on));
+  EXPECT_LT(on, 0.5 * off);
+}
+
+}  // namespace
+}  // namespace parallax
