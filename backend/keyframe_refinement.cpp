@@ -114,44 +114,56 @@ bool Linearise(const FrameWarp& w, float ray_x, float ray_y, float idepth, float
   return true;
 }
 
-/// Least-squares gain and offset of the frame's grey levels against the keyframe's at the
-/// points `which` (current poses and depths): tracking's affine model, re-fitted because the
-/// warp moves.
+/// Gain and offset of the frame's grey levels against the keyframe's at the points `which`
+/// (current poses and depths), tracking's affine model re-fitted because the warp moves:
+/// iteratively reweighted least squares with Huber weights, so that occluded or saturated
+/// points do not pull it (a plain fit moved the KITTI hard-exposure clip past its bound).
 void FitBrightness(const LevelPoints& points, const std::vector<float>& idepth,
-                   const std::vector<std::size_t>& which, FrameWarp* w) {
-  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+                   const std::vector<std::size_t>& which, const KeyframeRefinementOptions& options,
+                   FrameWarp* w) {
+  FrameWarp unit = *w;
+  unit.gain = 1.0f;
+  unit.offset = 0.0f;
+  std::vector<std::pair<float, float>> pairs;  // (keyframe, frame) grey levels
   for (const std::size_t i : which) {
     if (points.reference[i] < 0.0f) continue;
-    FrameWarp unit = *w;
-    unit.gain = 1.0f;
-    unit.offset = 0.0f;
     Linearised l;
     if (!Linearise(unit, points.ray_x[i], points.ray_y[i], idepth[i], points.reference[i], 1.0f,
                    &l)) {
       continue;
     }
-    const double x = points.reference[i], y = l.residual + x;  // the frame's grey level
-    n += 1;
-    sx += x;
-    sy += y;
-    sxx += x * x;
-    sxy += x * y;
+    pairs.emplace_back(points.reference[i], l.residual + points.reference[i]);
   }
-  const double det = n * sxx - sx * sx;
-  if (n < 10 || !(det > 1e-9 * n * n)) return;
-  const double gain = (n * sxy - sx * sy) / det;
-  if (!(gain > 0.1 && gain < 10.0)) return;
-  w->gain = static_cast<float>(gain);
-  w->offset = static_cast<float>((sy - gain * sx) / n);
+  if (pairs.size() < 10) return;
+  const float variance = options.pixel_noise_sigma * options.pixel_noise_sigma;
+  for (int it = 0; it < 3; ++it) {
+    double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (const auto& [x, y] : pairs) {
+      const float r = y - (w->gain * x + w->offset);
+      const double wt = HuberWeight(r, variance, options.huber_k).weight * variance;
+      n += wt;
+      sx += wt * x;
+      sy += wt * y;
+      sxx += wt * x * x;
+      sxy += wt * x * y;
+    }
+    const double det = n * sxx - sx * sx;
+    if (!(det > 1e-9 * n * n)) return;
+    const double gain = (n * sxy - sx * sy) / det;
+    if (!(gain > 0.1 && gain < 10.0)) return;
+    w->gain = static_cast<float>(gain);
+    w->offset = static_cast<float>((sy - gain * sx) / n);
+  }
 }
 
 /// The warps with brightness fitted on `which`.
 std::vector<FrameWarp> FittedWarps(const std::vector<RefinementFrame>& frames,
                                    const std::vector<SE3d>& T_kf_frame, int level,
                                    const LevelPoints& points, const std::vector<float>& idepth,
-                                   const std::vector<std::size_t>& which) {
+                                   const std::vector<std::size_t>& which,
+                                   const KeyframeRefinementOptions& options) {
   std::vector<FrameWarp> warps = Warps(frames, T_kf_frame, level);
-  for (FrameWarp& w : warps) FitBrightness(points, idepth, which, &w);
+  for (FrameWarp& w : warps) FitBrightness(points, idepth, which, options, &w);
   return warps;
 }
 
@@ -254,13 +266,13 @@ int JointLevel(const std::vector<RefinementFrame>& frames, const LevelPoints& po
   for (const std::size_t i : joint) mean += (*idepth)[i];
   mean /= static_cast<double>(joint.size());
   double lambda = options.initial_lambda;
-  double cost = Cost(FittedWarps(frames, *T_kf_frame, level, points, *idepth, joint), points,
-                     *idepth, joint, options);
+  double cost = Cost(FittedWarps(frames, *T_kf_frame, level, points, *idepth, joint, options),
+                     points, *idepth, joint, options);
   int accepted = 0;
   for (int it = 0; it < options.joint_iterations; ++it) {
     const ReducedSystem sys =
-        BuildReduced(FittedWarps(frames, *T_kf_frame, level, points, *idepth, joint), points,
-                     *idepth, joint, lambda, options);
+        BuildReduced(FittedWarps(frames, *T_kf_frame, level, points, *idepth, joint, options),
+                     points, *idepth, joint, lambda, options);
     const Eigen::VectorXd dx = sys.S.ldlt().solve(-sys.rhs);
     if (!dx.allFinite()) break;
     std::vector<SE3d> poses = *T_kf_frame;
@@ -281,8 +293,8 @@ int JointLevel(const std::vector<RefinementFrame>& frames, const LevelPoints& po
       depths[joint[k]] = static_cast<float>(d + std::clamp(step, -limit, limit));
     }
     HoldScale(joint, mean, &depths, &poses);
-    const double new_cost = Cost(FittedWarps(frames, poses, level, points, depths, joint), points,
-                                 depths, joint, options);
+    const double new_cost = Cost(FittedWarps(frames, poses, level, points, depths, joint, options),
+                                 points, depths, joint, options);
     if (new_cost < cost) {
       cost = new_cost;
       *T_kf_frame = std::move(poses);
@@ -354,15 +366,17 @@ KeyframeRefinementResult RefineKeyframe(const Frame& keyframe,
 
   std::vector<float> refined = idepth;
   const LevelPoints finest = PreparePoints(keyframe, pixel, 0);
-  result.initial_cost = Cost(FittedWarps(frames, result.T_kf_frame, 0, finest, refined, joint),
-                             finest, refined, joint, options);
+  result.initial_cost =
+      Cost(FittedWarps(frames, result.T_kf_frame, 0, finest, refined, joint, options), finest,
+           refined, joint, options);
   for (int level = coarsest; level >= 0; --level) {
     const LevelPoints points = level == 0 ? finest : PreparePoints(keyframe, pixel, level);
     result.iterations +=
         JointLevel(frames, points, joint, level, options, &result.T_kf_frame, &refined);
   }
-  result.final_cost = Cost(FittedWarps(frames, result.T_kf_frame, 0, finest, refined, joint),
-                           finest, refined, joint, options);
+  result.final_cost =
+      Cost(FittedWarps(frames, result.T_kf_frame, 0, finest, refined, joint, options), finest,
+           refined, joint, options);
   // Every point alone against the refined poses, coarse to fine, on at most
   // `point_frames` frames spread over the window (the last, widest baseline, included).
   // Points are independent: the parallel loop is deterministic.
@@ -379,7 +393,7 @@ KeyframeRefinementResult RefineKeyframe(const Frame& keyframe,
   for (int level = coarsest; level >= 0; --level) {
     const LevelPoints points = level == 0 ? finest : PreparePoints(keyframe, pixel, level);
     const std::vector<FrameWarp> warps =
-        FittedWarps(point_frames, point_poses, level, points, refined, joint);
+        FittedWarps(point_frames, point_poses, level, points, refined, joint, options);
     tbb::parallel_for(std::size_t{0}, pixel.size(), [&](std::size_t i) {
       if (points.reference[i] < 0.0f) return;
       seen[i] = RefinePoint(warps, points.ray_x[i], points.ray_y[i], points.reference[i], options,
