@@ -266,13 +266,14 @@ int JointLevel(const std::vector<RefinementFrame>& frames, const LevelPoints& po
   for (const std::size_t i : joint) mean += (*idepth)[i];
   mean /= static_cast<double>(joint.size());
   double lambda = options.initial_lambda;
-  double cost = Cost(FittedWarps(frames, *T_kf_frame, level, points, *idepth, joint, options),
-                     points, *idepth, joint, options);
+  // The warps (with brightness fitted) of the current state: kept from the evaluation that
+  // accepted it rather than fitted again for the next linearisation.
+  std::vector<FrameWarp> warps =
+      FittedWarps(frames, *T_kf_frame, level, points, *idepth, joint, options);
+  double cost = Cost(warps, points, *idepth, joint, options);
   int accepted = 0;
   for (int it = 0; it < options.joint_iterations; ++it) {
-    const ReducedSystem sys =
-        BuildReduced(FittedWarps(frames, *T_kf_frame, level, points, *idepth, joint, options),
-                     points, *idepth, joint, lambda, options);
+    const ReducedSystem sys = BuildReduced(warps, points, *idepth, joint, lambda, options);
     const Eigen::VectorXd dx = sys.S.ldlt().solve(-sys.rhs);
     if (!dx.allFinite()) break;
     std::vector<SE3d> poses = *T_kf_frame;
@@ -293,10 +294,12 @@ int JointLevel(const std::vector<RefinementFrame>& frames, const LevelPoints& po
       depths[joint[k]] = static_cast<float>(d + std::clamp(step, -limit, limit));
     }
     HoldScale(joint, mean, &depths, &poses);
-    const double new_cost = Cost(FittedWarps(frames, poses, level, points, depths, joint, options),
-                                 points, depths, joint, options);
+    std::vector<FrameWarp> new_warps =
+        FittedWarps(frames, poses, level, points, depths, joint, options);
+    const double new_cost = Cost(new_warps, points, depths, joint, options);
     if (new_cost < cost) {
       cost = new_cost;
+      warps = std::move(new_warps);
       *T_kf_frame = std::move(poses);
       *idepth = std::move(depths);
       lambda *= 0.5;
