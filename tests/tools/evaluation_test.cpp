@@ -200,5 +200,28 @@ TEST(Evaluation, KittiSegmentsOnLongPath) {
   EXPECT_NEAR(r.rpe_per_frame.translation.mean, 0.01, 1e-3);
 }
 
+TEST(Evaluation, LocalScaleShowsScaleDriftThatSim3AlignmentHides) {
+  // A 100 m drive whose second half is estimated 30% too long: one global scale cannot fit
+  // both halves, and the per-distance pairs show the two local scales.
+  Trajectory gt, est;
+  double x_est = 0.0;
+  for (int i = 0; i <= 100; ++i) {
+    gt.push_back({0.1 * i, SE3d(SO3d(), Eigen::Vector3d(0.0, 0.05 * std::sin(0.2 * i), i))});
+    if (i > 0) x_est += i <= 50 ? 1.0 : 1.3;
+    est.push_back({0.1 * i, SE3d(SO3d(), Eigen::Vector3d(0.0, 0.05 * std::sin(0.2 * i), x_est))});
+  }
+  EvaluationOptions options;
+  options.rpe_delta_meters = 10.0;
+  const EvaluationReport drift = Evaluate(est, gt, options);
+  ASSERT_GT(drift.local_scale.count, 80u);
+  // Aligned scale s: the halves come out as s and 1.3 s, whatever s is.
+  EXPECT_NEAR(drift.local_scale.max_ratio / drift.local_scale.min_ratio, 1.3, 0.01);
+  EXPECT_GT(drift.local_scale.log_rmse, 0.1);
+  const EvaluationReport exact = Evaluate(gt, gt, options);
+  EXPECT_NEAR(exact.local_scale.min_ratio, 1.0, 1e-9);
+  EXPECT_NEAR(exact.local_scale.max_ratio, 1.0, 1e-9);
+  EXPECT_LT(exact.local_scale.log_rmse, 1e-9);
+}
+
 }  // namespace
 }  // namespace parallax

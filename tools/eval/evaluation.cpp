@@ -31,6 +31,25 @@ RelativePoseError ComputeRpe(const std::vector<SE3d>& est, const std::vector<SE3
   return {ComputeStatistics(translation), ComputeStatistics(rotation)};
 }
 
+LocalScaleStatistics ComputeLocalScale(
+    const std::vector<SE3d>& est, const std::vector<SE3d>& gt,
+    const std::vector<std::pair<std::size_t, std::size_t>>& pairs) {
+  LocalScaleStatistics stats;
+  double sum_log_sq = 0.0;
+  for (const auto& [i, j] : pairs) {
+    const double gt_length = (gt[j].Translation() - gt[i].Translation()).norm();
+    if (!(gt_length > 0.0)) continue;
+    const double ratio = (est[j].Translation() - est[i].Translation()).norm() / gt_length;
+    stats.min_ratio = stats.count ? std::min(stats.min_ratio, ratio) : ratio;
+    stats.max_ratio = stats.count ? std::max(stats.max_ratio, ratio) : ratio;
+    const double log_ratio = ratio > 0.0 ? std::log(ratio) : 0.0;
+    sum_log_sq += log_ratio * log_ratio;
+    ++stats.count;
+  }
+  if (stats.count) stats.log_rmse = std::sqrt(sum_log_sq / static_cast<double>(stats.count));
+  return stats;
+}
+
 std::vector<KittiSegmentError> ComputeKittiErrors(const std::vector<SE3d>& est,
                                                   const std::vector<SE3d>& gt) {
   std::vector<double> distance(gt.size(), 0.0);
@@ -170,6 +189,7 @@ EvaluationReport Evaluate(const Trajectory& estimate, const Trajectory& groundtr
       per_distance.emplace_back(i, j);
     }
     report.rpe_per_distance = ComputeRpe(est, gt, per_distance);
+    report.local_scale = ComputeLocalScale(est, gt, per_distance);
   }
   report.kitti = ComputeKittiErrors(est, gt);
   return report;
@@ -192,6 +212,11 @@ std::string FormatReport(const EvaluationReport& r) {
   rpe("RPE/frame   ", r.rpe_per_frame);
   rpe("RPE/second  ", r.rpe_per_second);
   rpe(fmt::format("RPE/{:.3g} m", r.rpe_delta_meters).c_str(), r.rpe_per_distance);
+  if (r.local_scale.count > 0) {
+    s += fmt::format("scale/{:.3g} m local scale {:.3f} .. {:.3f}  rms |ln| {:.4f}  ({} pairs)\n",
+                     r.rpe_delta_meters, r.local_scale.min_ratio, r.local_scale.max_ratio,
+                     r.local_scale.log_rmse, r.local_scale.count);
+  }
   if (r.frames > 0) {
     s += fmt::format("frames       {} of {} image frames have a pose\n", r.frames_with_pose,
                      r.frames);
@@ -244,6 +269,11 @@ std::string ReportToJson(const EvaluationReport& r) {
                              {{"delta", r.rpe_delta_meters},
                               {"translation", stats(r.rpe_per_distance.translation)},
                               {"rotation_deg", stats(r.rpe_per_distance.rotation_deg)}}},
+                            {"local_scale",
+                             {{"count", r.local_scale.count},
+                              {"min_ratio", r.local_scale.min_ratio},
+                              {"max_ratio", r.local_scale.max_ratio},
+                              {"log_rmse", r.local_scale.log_rmse}}},
                             {"kitti_segments", kitti}};
   return j.dump(2);
 }

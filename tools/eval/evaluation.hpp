@@ -43,6 +43,17 @@ struct RelativePoseError {
   ErrorStatistics rotation_deg;
 };
 
+/// Monocular scale drift along the path: for pose pairs rpe_delta_meters of ground-truth path
+/// apart, ratio = |estimated displacement| / |ground-truth displacement| after alignment, so a
+/// trajectory without scale drift has every ratio near 1 under sim3 alignment
+/// (docs/evaluation.md).
+struct LocalScaleStatistics {
+  std::size_t count = 0;
+  double min_ratio = 0.0;
+  double max_ratio = 0.0;
+  double log_rmse = 0.0;  ///< rms of ln(ratio)
+};
+
 /// Average of KITTI's drift over one segment length (e.g. 100 m).
 struct KittiSegmentError {
   double length = 0.0;
@@ -69,6 +80,7 @@ struct EvaluationReport {
   RelativePoseError rpe_per_second;      ///< pairs rpe_delta_seconds apart
   double rpe_delta_meters = 0.0;         ///< the step actually used
   RelativePoseError rpe_per_distance;    ///< pairs rpe_delta_meters of ground-truth path apart
+  LocalScaleStatistics local_scale;      ///< over the same pairs as rpe_per_distance
   std::vector<KittiSegmentError> kitti;  ///< lengths 100..800 m that fit in the path
 };
 
