@@ -16,6 +16,7 @@ void UpdateDirectionOptions::Check() const {
               "must be in (0, 180]");
   CheckOption(std::isfinite(recheck_growth), s, "recheck_growth", "must be finite");
   CheckOption(reuse_max_angle_deg >= 0.0, s, "reuse_max_angle_deg", "must be >= 0");
+  CheckOption(reuse_max_rotation_deg >= 0.0, s, "reuse_max_rotation_deg", "must be >= 0");
   CheckOption(max_axis_angle_deg >= 0.0 && max_axis_angle_deg <= 90.0, s, "max_axis_angle_deg",
               "must be in [0, 90]");
   matcher.Check();
@@ -66,8 +67,10 @@ SE3d UpdateDirection::Refine(std::int64_t keyframe_id, const ImageU8& frame, con
   if (has_check_ && options_.recheck_growth > 1.0 &&
       relative_baseline < checked_baseline_ * options_.recheck_growth &&
       relative_baseline * options_.recheck_growth > checked_baseline_ &&
-      AngleBetweenDeg(t, checked_direction_) <= options_.reuse_max_angle_deg) {
-    return SE3d(T_kf_frame.Rotation(), correction_ * t);
+      AngleBetweenDeg(t, checked_direction_) <= options_.reuse_max_angle_deg &&
+      (checked_rotation_.Inverse() * T_kf_frame.Rotation()).Log().norm() * kRadToDeg <=
+          options_.reuse_max_rotation_deg) {
+    return SE3d(rotation_correction_ * T_kf_frame.Rotation(), correction_ * t);
   }
   if (!pairs_) pairs_ = std::make_unique<TwoViewBootstrap>(camera_, options_.matcher);
   if (!features_extracted_) {
@@ -82,11 +85,21 @@ SE3d UpdateDirection::Refine(std::int64_t keyframe_id, const ImageU8& frame, con
       -(pair->T_frame_ref.Rotation().Inverse() * pair->T_frame_ref.Translation());
   const Eigen::Vector3d blended =
       BlendDirections(t, centre, options_.essential_weight, options_.max_angle_deg);
+  rotation_correction_ = SO3d();
+  if (options_.blend_rotation && blended != t) {
+    // Geodesic blend, the same share as the direction's: R_t Exp(w Log(R_t^-1 R_e)).
+    const SO3d& R_tracked = T_kf_frame.Rotation();
+    const SO3d R_essential = pair->T_frame_ref.Rotation().Inverse();
+    const SO3d R_blended = R_tracked * SO3d::Exp(options_.essential_weight *
+                                                 (R_tracked.Inverse() * R_essential).Log());
+    rotation_correction_ = R_blended * R_tracked.Inverse();
+  }
   has_check_ = true;
   checked_direction_ = t;
   checked_baseline_ = relative_baseline;
+  checked_rotation_ = T_kf_frame.Rotation();
   correction_ = SO3d(Eigen::Quaterniond::FromTwoVectors(t, blended));
-  return SE3d(T_kf_frame.Rotation(), blended);
+  return SE3d(rotation_correction_ * T_kf_frame.Rotation(), blended);
 }
 
 }  // namespace parallax

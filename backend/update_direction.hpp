@@ -21,6 +21,13 @@ struct UpdateDirectionOptions {
   double min_relative_baseline = 0.03;
   /// Share of the essential-matrix direction in the blend (0 = tracking only).
   double essential_weight = 0.5;
+  /// Also move the update pose's rotation the same share towards the essential matrix's
+  /// relative rotation (whenever the direction is blended). Rotation and translation direction
+  /// are one hypothesis: in a turn, tracking trades yaw against sideways translation (KITTI 07:
+  /// 0.3-0.5 degrees of yaw with a 4-5 degree direction error), and a depth update that keeps
+  /// the tracked yaw while taking the essential matrix's direction triangulates with a pose
+  /// that neither view supports (docs/math/depth_filter.md, "Direction of the update pose").
+  bool blend_rotation = true;
   /// The two directions must agree within this angle, degrees; otherwise tracking is kept.
   /// Small corrections only: they stop the slow drift of the tracked direction, while the
   /// essential matrix itself can be 5-10 degrees off on weak texture (docs/benchmarks.md has
@@ -42,6 +49,9 @@ struct UpdateDirectionOptions {
   /// recheck_growth <= 1 checks every update.
   double recheck_growth = 1.5;
   double reuse_max_angle_deg = 5.0;
+  /// ... and while the frame has turned at most this much from the checked one, degrees (in
+  /// a turn, where the tracked yaw and direction go wrong together, every update is checked).
+  double reuse_max_rotation_deg = 1.0;
   TwoViewBootstrapOptions matcher{
       .max_features = 800, .min_inliers = 100, .min_parallax_deg = 0.5, .parallax_points = 30};
 
@@ -91,7 +101,9 @@ class UpdateDirection {
   bool has_check_ = false;
   Eigen::Vector3d checked_direction_ = Eigen::Vector3d::Zero();
   double checked_baseline_ = 0.0;
-  SO3d correction_;
+  SO3d checked_rotation_;
+  SO3d correction_;           // tracked direction -> blended direction
+  SO3d rotation_correction_;  // R_kf_frame tracked -> blended, applied on the left
 };
 
 }  // namespace parallax

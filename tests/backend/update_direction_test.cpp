@@ -51,11 +51,17 @@ class UpdateDirectionTest : public test::RoomPairTest {
   /// keyframe coordinates), found with the check's own matcher; nullopt without a pair.
   std::optional<Eigen::Vector3d> EssentialDirection(const ImageU8& keyframe,
                                                     const ImageU8& frame) const {
+    const std::optional<SE3d> T_kf_frame = EssentialPose(keyframe, frame);
+    if (!T_kf_frame) return std::nullopt;
+    return T_kf_frame->Translation();
+  }
+  /// The essential matrix's keyframe -> frame pose T_kf_frame (translation up to scale).
+  std::optional<SE3d> EssentialPose(const ImageU8& keyframe, const ImageU8& frame) const {
     TwoViewBootstrap matcher(camera_, UpdateDirectionOptions{}.matcher);
     matcher.SetReference(keyframe);
     const std::optional<TwoViewPair> pair = matcher.TryFrame(frame);
     if (!pair) return std::nullopt;
-    return -(pair->T_frame_ref.Rotation().Inverse() * pair->T_frame_ref.Translation());
+    return pair->T_frame_ref.Inverse();
   }
   /// A tracked pose: the true rotation, and a 0.21 long translation turned `deg` degrees about
   /// the y axis from `direction`.
@@ -85,6 +91,7 @@ TEST_F(UpdateDirectionTest, BlendsTheTrackedDirectionWithTheEssentialMatrix) {
   UpdateDirectionOptions every_update;
   every_update.recheck_growth = 1.0;       // no reuse of a correction (tested below)
   every_update.max_axis_angle_deg = 90.0;  // this step is mostly sideways (tested below)
+  every_update.blend_rotation = false;     // the direction alone (rotation: tested below)
   UpdateDirection direction(camera_, every_update);
   direction.SetKeyframe(3, keyframe);
   const SE3d T_tracked = tracked_at(2.0);
@@ -151,6 +158,48 @@ TEST_F(UpdateDirectionTest, SidewaysMotionIsNotChecked) {
   UpdateDirection lifted(camera_, any_direction);
   lifted.SetKeyframe(3, keyframe);
   EXPECT_NE(lifted.Refine(3, frame, tracked, 0.1).Translation(), tracked.Translation());
+}
+
+// In a turn tracking trades yaw against sideways translation; the check moves the rotation
+// the same share (0.5) towards the essential matrix's as the direction, along the geodesic,
+// and a reused correction carries the rotation's part too.
+TEST_F(UpdateDirectionTest, BlendsTheRotationWithTheDirection) {
+  const SE3d T_true(SO3d::Exp(Eigen::Vector3d(0.0, 2.0 / kRadToDeg, 0.0)),
+                    Eigen::Vector3d(0.20, 0.0, 0.05));
+  const ImageU8 keyframe = Render(SE3d()), frame = Render(T_true);
+  const std::optional<SE3d> found = EssentialPose(keyframe, frame);
+  ASSERT_TRUE(found.has_value());
+  const SO3d R_essential = found->Rotation();
+  EXPECT_LT((R_essential.Inverse() * T_true.Rotation()).Log().norm() * kRadToDeg, 1.0);
+  // Tracked: 1 degree more yaw than the essential matrix, direction 2 degrees off.
+  const auto tracked_at = [&](double deg) {
+    const SE3d direction_only = TrackedAt(T_true, found->Translation(), deg);
+    return SE3d(R_essential * SO3d::Exp(Eigen::Vector3d(0.0, 1.0 / kRadToDeg, 0.0)),
+                direction_only.Translation());
+  };
+  const auto degrees = [](const SO3d& a, const SO3d& b) {
+    return (a.Inverse() * b).Log().norm() * kRadToDeg;
+  };
+  UpdateDirectionOptions options;
+  options.max_axis_angle_deg = 90.0;
+  UpdateDirection direction(camera_, options);
+  direction.SetKeyframe(3, keyframe);
+  const SE3d tracked = tracked_at(2.0);
+  const SE3d refined = direction.Refine(3, frame, tracked, 0.1);
+  EXPECT_NEAR(degrees(refined.Rotation(), R_essential), 0.5, 1e-6);
+  EXPECT_NEAR(degrees(refined.Rotation(), tracked.Rotation()), 0.5, 1e-6);
+  EXPECT_NEAR(AngleBetweenDeg(refined.Translation(), tracked.Translation()), 1.0, 0.01);
+  // Reused for the next frame (1 degree further, similar baseline): the same correction.
+  const SE3d next(tracked.Rotation() * SO3d::Exp(Eigen::Vector3d(0.0, 0.2 / kRadToDeg, 0.0)),
+                  tracked_at(3.0).Translation());
+  const SE3d reused = direction.Refine(3, frame, next, 0.11);
+  const SO3d correction = refined.Rotation() * tracked.Rotation().Inverse();
+  EXPECT_LT(degrees(reused.Rotation(), correction * next.Rotation()), 1e-9);
+  // Beyond the direction gate neither is touched.
+  const SE3d far_off = tracked_at(5.0);
+  const SE3d kept = direction.Refine(3, frame, far_off, 0.2);
+  EXPECT_EQ(kept.Rotation().UnitQuaternion().coeffs(),
+            far_off.Rotation().UnitQuaternion().coeffs());
 }
 
 TEST_F(UpdateDirectionTest, DisabledLeavesThePoseAlone) {
