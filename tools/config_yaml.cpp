@@ -36,6 +36,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"affine_prior_a", Set(&o->tracker.affine_prior_a)},
         {"affine_prior_b", Set(&o->tracker.affine_prior_b)},
         {"good_threshold", Set(&o->tracker.good_threshold)},
+        {"suspect_good_ratio", Set(&o->tracker.suspect_good_ratio)},
         {"min_good_ratio_ok", Set(&o->tracker.min_good_ratio_ok)},
         {"min_good_ratio_poor", Set(&o->tracker.min_good_ratio_poor)}}},
       {"depth",

@@ -49,6 +49,8 @@ void Se3TrackerOptions::Check() const {
               "must be in [0, min_usage_ok]");
   CheckOption(relative_cost_tolerance >= 0.0f, s, "relative_cost_tolerance", "must be >= 0");
   CheckOption(hypothesis_iterations >= 0, s, "hypothesis_iterations", "must be >= 0");
+  CheckOption(suspect_good_ratio >= 0.0f && suspect_good_ratio <= 1.0f, s, "suspect_good_ratio",
+              "must be in [0, 1] (0 disables)");
 }
 
 Se3Tracker::Se3Tracker(const Se3TrackerOptions& options) : options_(options) { options_.Check(); }
@@ -208,17 +210,13 @@ TrackingResult Se3Tracker::Track(const TrackingReference& reference, const Frame
   CheckArgument(!hypotheses.empty(), "Se3Tracker::Track: at least one pose hypothesis is needed");
   TrackingResult best = TrackFrom(reference, frame, hypotheses.front(), affine_guess);
   best.stats.hypotheses_tried = 1;
-  if (best.status == TrackingStatus::kOk) return best;
+  const bool suspect =
+      best.status == TrackingStatus::kOk && best.stats.good_ratio < options_.suspect_good_ratio;
+  if (best.status == TrackingStatus::kOk && !suspect) return best;
   // Score the alternatives cheaply at the coarsest level.
   std::vector<SE3d> candidates(hypotheses.begin() + 1, hypotheses.end());
-  constexpr double kSmallRotation = 0.03;  // rad, ~1.7 degrees
-  for (int axis = 0; axis < 3; ++axis) {
-    for (const double sign : {-1.0, 1.0}) {
-      Eigen::Matrix<double, 6, 1> xi = Eigen::Matrix<double, 6, 1>::Zero();
-      xi[3 + axis] = sign * kSmallRotation;
-      candidates.push_back(hypotheses.front() * SE3d::Exp(xi));
-    }
-  }
+  AddSmallRotations(hypotheses.front(), &candidates);
+  if (suspect) AddSmallRotations(best.T_kf_frame, &candidates);
   const int coarsest = reference.NumLevels() - 1;
   const AffineBrightness prior = options_.estimate_affine ? affine_guess : AffineBrightness{};
   double best_cost = std::numeric_limits<double>::infinity();
@@ -245,6 +243,17 @@ TrackingResult Se3Tracker::Track(const TrackingReference& reference, const Frame
   }
   best.stats.hypotheses_tried = static_cast<int>(candidates.size()) + 1;
   return best;
+}
+
+void AddSmallRotations(const SE3d& T_kf_frame, std::vector<SE3d>* candidates) {
+  constexpr double kSmallRotation = 0.03;  // rad, ~1.7 degrees
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const double sign : {-1.0, 1.0}) {
+      Eigen::Matrix<double, 6, 1> xi = Eigen::Matrix<double, 6, 1>::Zero();
+      xi[3 + axis] = sign * kSmallRotation;
+      candidates->push_back(T_kf_frame * SE3d::Exp(xi));
+    }
+  }
 }
 
 std::vector<SE3d> MotionHypotheses(const SE3d& T_kf_last, const SE3d& T_prev_last) {

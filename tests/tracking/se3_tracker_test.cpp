@@ -231,6 +231,32 @@ TEST_F(Se3TrackerRenderTest, HypothesesRecoverFromABadFirstGuess) {
   EXPECT_LT(ComparePoses(result.T_kf_frame, TrueKfFrame(10)).rotation_deg, 0.05);
 }
 
+// An "ok" result with few consistent points is searched again; the search keeps a right
+// result right, and is skipped above the bar or with the bar at 0.
+TEST_F(Se3TrackerRenderTest, SuspectOkResultsAreSearchedAgain) {
+  const TrackingReference reference(keyframe_->frame, keyframe_->idepth, keyframe_->variance);
+  const auto frame = test::RenderTestFrame(*scene_, Pose(10), 1);
+  const std::vector<SE3d> start = {Perturb(TrueKfFrame(10), 1.0, 0.01, 0)};
+  Se3Tracker tracker;
+  const TrackingResult first = tracker.Track(reference, *frame, start);
+  ASSERT_EQ(first.status, TrackingStatus::kOk);
+  EXPECT_GT(first.stats.good_ratio, tracker.Options().suspect_good_ratio);
+  EXPECT_EQ(first.stats.hypotheses_tried, 1);
+  // A bar above what the result has: searched, and the result stays right.
+  Se3TrackerOptions demanding;
+  demanding.suspect_good_ratio = 1.0f;
+  Se3Tracker strict(demanding);
+  const TrackingResult searched = strict.Track(reference, *frame, start);
+  EXPECT_EQ(searched.stats.hypotheses_tried, 13);  // the start, 6 rotations of it, 6 of the result
+  EXPECT_EQ(searched.status, TrackingStatus::kOk);
+  EXPECT_LT(ComparePoses(searched.T_kf_frame, TrueKfFrame(10)).rotation_deg, 0.05);
+  // The bar at 0: never searched.
+  Se3TrackerOptions off;
+  off.suspect_good_ratio = 0.0f;
+  Se3Tracker trusting(off);
+  EXPECT_EQ(trusting.Track(reference, *frame, start).stats.hypotheses_tried, 1);
+}
+
 TEST_F(Se3TrackerRenderTest, DeterministicResults) {
   const TrackingReference reference(keyframe_->frame, keyframe_->idepth, keyframe_->variance);
   const auto frame = test::RenderTestFrame(*scene_, Pose(6), 1, 1.2f, 3.0);
