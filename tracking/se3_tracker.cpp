@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/angles.hpp"
 #include "core/check.hpp"
 #include "tracking/levenberg_marquardt.hpp"
 #include "tracking/photometric_residual.hpp"
@@ -51,6 +52,11 @@ void Se3TrackerOptions::Check() const {
   CheckOption(hypothesis_iterations >= 0, s, "hypothesis_iterations", "must be >= 0");
   CheckOption(suspect_good_ratio >= 0.0f && suspect_good_ratio <= 1.0f, s, "suspect_good_ratio",
               "must be in [0, 1] (0 disables)");
+  CheckOption(!search_rotations_deg.empty(), s, "search_rotations_deg", "must not be empty");
+  for (const double angle : search_rotations_deg) {
+    CheckOption(std::isfinite(angle) && angle > 0.0 && angle < 90.0, s, "search_rotations_deg",
+                "must be in (0, 90)");
+  }
 }
 
 Se3Tracker::Se3Tracker(const Se3TrackerOptions& options) : options_(options) { options_.Check(); }
@@ -215,8 +221,8 @@ TrackingResult Se3Tracker::Track(const TrackingReference& reference, const Frame
   if (best.status == TrackingStatus::kOk && !suspect) return best;
   // Score the alternatives cheaply at the coarsest level.
   std::vector<SE3d> candidates(hypotheses.begin() + 1, hypotheses.end());
-  AddSmallRotations(hypotheses.front(), &candidates);
-  if (suspect) AddSmallRotations(best.T_kf_frame, &candidates);
+  AddRotations(hypotheses.front(), options_.search_rotations_deg, &candidates);
+  if (suspect) AddRotations(best.T_kf_frame, options_.search_rotations_deg, &candidates);
   const int coarsest = reference.NumLevels() - 1;
   const AffineBrightness prior = options_.estimate_affine ? affine_guess : AffineBrightness{};
   double best_cost = std::numeric_limits<double>::infinity();
@@ -245,13 +251,15 @@ TrackingResult Se3Tracker::Track(const TrackingReference& reference, const Frame
   return best;
 }
 
-void AddSmallRotations(const SE3d& T_kf_frame, std::vector<SE3d>* candidates) {
-  constexpr double kSmallRotation = 0.03;  // rad, ~1.7 degrees
-  for (int axis = 0; axis < 3; ++axis) {
-    for (const double sign : {-1.0, 1.0}) {
-      Eigen::Matrix<double, 6, 1> xi = Eigen::Matrix<double, 6, 1>::Zero();
-      xi[3 + axis] = sign * kSmallRotation;
-      candidates->push_back(T_kf_frame * SE3d::Exp(xi));
+void AddRotations(const SE3d& T_kf_frame, const std::vector<double>& angles_deg,
+                  std::vector<SE3d>* candidates) {
+  for (const double angle : angles_deg) {
+    for (int axis = 0; axis < 3; ++axis) {
+      for (const double sign : {-1.0, 1.0}) {
+        Eigen::Matrix<double, 6, 1> xi = Eigen::Matrix<double, 6, 1>::Zero();
+        xi[3 + axis] = sign * angle / kRadToDeg;
+        candidates->push_back(T_kf_frame * SE3d::Exp(xi));
+      }
     }
   }
 }

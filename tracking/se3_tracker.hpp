@@ -50,6 +50,12 @@ struct Se3TrackerOptions {
   /// 0.85-0.97). The alternatives are then searched as for a result that is not ok, plus
   /// small rotations around the result itself; the better result wins. 0 disables.
   float suspect_good_ratio = 0.75f;
+  /// The search's rotations about each camera axis, degrees, tried around the first motion
+  /// hypothesis (and around a suspect result). {1.7, 5.7, 11.5} reaches a turn that starts
+  /// between two frames (~12 degrees from the constant-velocity start; the rendered patrols'
+  /// U-turns); the default keeps the earlier 0.03 rad alone (docs/math/tracking.md, "Wide
+  /// search rotations").
+  std::vector<double> search_rotations_deg = {1.718873385};  // 0.03 rad
 
   void Check() const;
 };
@@ -108,7 +114,8 @@ class Se3Tracker {
 /// motion T_prev_last (pose of the last frame in the previous one): constant velocity, half
 /// and double velocity, zero motion, and the keyframe pose itself.
 std::vector<SE3d> MotionHypotheses(const SE3d& T_kf_last, const SE3d& T_prev_last);
-/// Appends the six poses turned +-0.03 rad (~1.7 degrees) about each camera axis.
-void AddSmallRotations(const SE3d& T_kf_frame, std::vector<SE3d>* candidates);
+/// Appends, for each angle (degrees), the six poses turned by +-angle about each camera axis.
+void AddRotations(const SE3d& T_kf_frame, const std::vector<double>& angles_deg,
+                  std::vector<SE3d>* candidates);
 
 }  // namespace parallax

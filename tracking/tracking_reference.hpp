@@ -16,6 +16,11 @@ struct TrackingReferenceOptions {
   float min_gradient = 5.0f;
   /// Pixels this close to the image border are not used (level 0 pixels).
   int border = 2;
+  /// Point budget: each level keeps at most this many points, every k-th in raster order so
+  /// that they sample the map like the full set (0: all). Tracking and keyframe alignment
+  /// cost scale with it; off by default because fewer points track fast turns worse
+  /// (docs/benchmarks.md, "Tracking point budget").
+  std::size_t max_points_per_level = 0;
 
   void Check() const;
 };

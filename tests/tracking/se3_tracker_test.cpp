@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <numeric>
+
 #include "tests/tracking/render_fixture.hpp"
 #include "tracking/photometric_residual.hpp"
 
@@ -257,6 +259,33 @@ TEST_F(Se3TrackerRenderTest, SuspectOkResultsAreSearchedAgain) {
   EXPECT_EQ(trusting.Track(reference, *frame, start).stats.hypotheses_tried, 1);
 }
 
+// A camera that starts turning between two frames: the only hypothesis (constant velocity)
+// is 11 degrees of yaw from the truth. Rotations of 1.7 degrees alone (the default) do not
+// reach its basin; the wide search angles do.
+TEST_F(Se3TrackerRenderTest, WideSearchRotationsRecoverASuddenTurn) {
+  const TrackingReference reference(keyframe_->frame, keyframe_->idepth, keyframe_->variance);
+  const auto frame = test::RenderTestFrame(*scene_, Pose(10), 1);
+  Eigen::Matrix<double, 6, 1> yaw = Eigen::Matrix<double, 6, 1>::Zero();
+  yaw[4] = 11.0 * 3.14159265358979 / 180.0;
+  const std::vector<SE3d> start = {TrueKfFrame(10) * SE3d::Exp(yaw)};
+  Se3Tracker narrow;
+  const TrackingResult missed = narrow.Track(reference, *frame, start);
+  const double missed_deg = ComparePoses(missed.T_kf_frame, TrueKfFrame(10)).rotation_deg;
+  EXPECT_TRUE(missed.status != TrackingStatus::kOk || missed_deg > 1.0)
+      << ToString(missed.status) << " " << missed_deg;
+  Se3TrackerOptions wide_options;
+  wide_options.search_rotations_deg = {1.7, 5.7, 11.5};
+  Se3Tracker wide(wide_options);
+  const TrackingResult found = wide.Track(reference, *frame, start);
+  EXPECT_EQ(found.status, TrackingStatus::kOk) << found.stats.reason;
+  EXPECT_LT(ComparePoses(found.T_kf_frame, TrueKfFrame(10)).rotation_deg, 0.05);
+  Se3TrackerOptions bad;
+  bad.search_rotations_deg = {0.0};
+  EXPECT_THROW(bad.Check(), std::invalid_argument);
+  bad.search_rotations_deg = {};
+  EXPECT_THROW(bad.Check(), std::invalid_argument);
+}
+
 TEST_F(Se3TrackerRenderTest, DeterministicResults) {
   const TrackingReference reference(keyframe_->frame, keyframe_->idepth, keyframe_->variance);
   const auto frame = test::RenderTestFrame(*scene_, Pose(6), 1, 1.2f, 3.0);
@@ -265,6 +294,35 @@ TEST_F(Se3TrackerRenderTest, DeterministicResults) {
   const TrackingResult rb = b.TrackFrom(reference, *frame, SE3d(), {});
   EXPECT_EQ(ra.T_kf_frame.Matrix(), rb.T_kf_frame.Matrix());
   EXPECT_EQ(ra.affine.a, rb.affine.a);
+}
+
+// The point budget keeps at most max_points_per_level per level, spread over the image like
+// the full set, and a tracker on the thinned reference still converges.
+TEST_F(Se3TrackerRenderTest, PointBudgetThinsEveryLevelEvenly) {
+  const TrackingReference full(keyframe_->frame, keyframe_->idepth, keyframe_->variance);
+  TrackingReferenceOptions options;
+  options.max_points_per_level = 3000;
+  const TrackingReference thin(keyframe_->frame, keyframe_->idepth, keyframe_->variance, options);
+  ASSERT_EQ(thin.NumLevels(), full.NumLevels());
+  for (int l = 0; l < full.NumLevels(); ++l) {
+    const ReferenceLevel& a = full.Level(l);
+    const ReferenceLevel& b = thin.Level(l);
+    EXPECT_EQ(b.Size(), std::min<std::size_t>(a.Size(), 3000u)) << "level " << l;
+    const auto mean = [](const std::vector<float>& v) {
+      return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+    };
+    const double width = keyframe_->frame->Level(l).Width();
+    EXPECT_NEAR(mean(b.u), mean(a.u), 0.02 * width) << "level " << l;
+    EXPECT_NEAR(mean(b.v), mean(a.v), 0.02 * width) << "level " << l;
+    EXPECT_NEAR(mean(b.idepth), mean(a.idepth), 0.02 * mean(a.idepth)) << "level " << l;
+  }
+  EXPECT_EQ(thin.MeanIdepth(), full.MeanIdepth());
+  const auto frame = test::RenderTestFrame(*scene_, Pose(10), 1);
+  Se3Tracker tracker;
+  const TrackingResult result =
+      tracker.TrackFrom(thin, *frame, Perturb(TrueKfFrame(10), 3.0, 0.05, 0), {});
+  EXPECT_EQ(result.status, TrackingStatus::kOk);
+  EXPECT_LT(ComparePoses(result.T_kf_frame, TrueKfFrame(10)).rotation_deg, 0.1);
 }
 
 TEST(TrackingReference, CoarseLevelsAreInverseVarianceWeighted) {
