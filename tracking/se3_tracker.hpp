@@ -3,6 +3,7 @@
 
 #include <vector>
 
+#include "core/angles.hpp"
 #include "core/frame.hpp"
 #include "core/normal_equations.hpp"
 #include "tracking/tracking_reference.hpp"
@@ -55,7 +56,7 @@ struct Se3TrackerOptions {
   /// between two frames (~12 degrees from the constant-velocity start; the rendered patrols'
   /// U-turns); the default keeps the earlier 0.03 rad alone (docs/math/tracking.md, "Wide
   /// search rotations").
-  std::vector<double> search_rotations_deg = {1.718873385};  // 0.03 rad
+  std::vector<double> search_rotations_deg = {0.03 * kRadToDeg};
 
   void Check() const;
 };

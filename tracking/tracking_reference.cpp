@@ -1,8 +1,6 @@
 #include "tracking/tracking_reference.hpp"
 
-#include <array>
 #include <cmath>
-#include <cstdint>
 
 #include "core/check.hpp"
 
@@ -50,31 +48,19 @@ ReferenceLevel Coarsen(const ReferenceLevel& fine, const Frame& frame, int coars
   return coarse;
 }
 
-constexpr std::array<std::vector<float> ReferenceLevel::*, 7> kFields = {
-    &ReferenceLevel::u,        &ReferenceLevel::v,      &ReferenceLevel::ray_x,
-    &ReferenceLevel::ray_y,    &ReferenceLevel::idepth, &ReferenceLevel::variance,
-    &ReferenceLevel::intensity};
-
-// Keeps the points whose `keep` flag is set, in their order.
-void Compact(const std::vector<std::uint8_t>& keep, ReferenceLevel* level) {
-  std::size_t kept = 0;
-  for (std::size_t i = 0; i < keep.size(); ++i) {
-    if (!keep[i]) continue;
-    for (auto field : kFields) (level->*field)[kept] = (level->*field)[i];
-    ++kept;
-  }
-  for (auto field : kFields) (level->*field).resize(kept);
-}
-
 // Keeps `budget` of the level's points spread evenly over their raster order, so that the
 // kept points sample the map like the full set (selecting the strongest gradients per cell
 // was tried: TUM 6.0 -> 7.9 mm at 5,000 points, docs/benchmarks.md).
 void ThinLevel(std::size_t budget, ReferenceLevel* level) {
   const std::size_t n = level->Size();
   if (budget == 0 || n <= budget) return;
-  std::vector<std::uint8_t> keep(n);
-  for (std::size_t i = 0; i < n; ++i) keep[i] = (i + 1) * budget / n != i * budget / n;
-  Compact(keep, level);
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if ((i + 1) * budget / n == i * budget / n) continue;
+    for (const auto field : kReferenceLevelFields) (level->*field)[kept] = (level->*field)[i];
+    ++kept;
+  }
+  for (const auto field : kReferenceLevelFields) (level->*field).resize(kept);
 }
 
 }  // namespace

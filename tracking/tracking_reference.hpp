@@ -2,6 +2,7 @@
 // The keyframe side of direct image alignment: semi-dense points with inverse depth per
 // pyramid level, built once per keyframe and reused for every tracked frame.
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -37,11 +38,18 @@ struct ReferenceLevel {
   std::vector<float> intensity;  ///< keyframe intensity at the pixel (this level)
 
   std::size_t Size() const { return u.size(); }
-  void Reserve(std::size_t n) {
-    for (std::vector<float>* field : {&u, &v, &ray_x, &ray_y, &idepth, &variance, &intensity})
-      field->reserve(n);
-  }
+  void Reserve(std::size_t n);
 };
+
+/// Every per-point array of a ReferenceLevel (for operations applied to all of them).
+inline constexpr std::array<std::vector<float> ReferenceLevel::*, 7> kReferenceLevelFields = {
+    &ReferenceLevel::u,        &ReferenceLevel::v,      &ReferenceLevel::ray_x,
+    &ReferenceLevel::ray_y,    &ReferenceLevel::idepth, &ReferenceLevel::variance,
+    &ReferenceLevel::intensity};
+
+inline void ReferenceLevel::Reserve(std::size_t n) {
+  for (const auto field : kReferenceLevelFields) (this->*field).reserve(n);
+}
 
 /// Semi-dense points of a keyframe for tracking. Level 0 takes every pixel with valid
 /// inverse depth and enough gradient; level l+1 combines the (up to four) level-l points of
