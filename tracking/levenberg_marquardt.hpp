@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace parallax {
@@ -39,12 +41,17 @@ inline int MaxIterationsForLevel(const std::vector<int>& per_level, int level) {
 /// Minimises from *state. `linearize(state)` returns LinearizedProblem<N>; `retract(state,
 /// delta)` applies a step. Steps solve (H + lambda diag(H)) delta = -g; lambda is 0 while
 /// steps succeed, 0.2 after a failure and x4 per further failure (LSD-SLAM's schedule).
-/// Returns the number of iterations.
-template <int N, typename State, typename Linearize, typename Retract>
+/// `linearize` may return a type derived from LinearizedProblem<N> that carries more of the
+/// evaluation; `final_problem` (optional) receives the linearisation at the returned state,
+/// so that a caller need not evaluate it again. Returns the number of iterations.
+template <int N, typename State, typename Linearize, typename Retract,
+          typename Problem = std::invoke_result_t<Linearize, const State&>>
 int MinimizeLevenbergMarquardt(State* state, const Linearize& linearize, const Retract& retract,
-                               const LmSettings& settings) {
+                               const LmSettings& settings, Problem* final_problem = nullptr) {
+  static_assert(std::is_base_of_v<LinearizedProblem<N>, Problem>,
+                "linearize must return a LinearizedProblem<N>");
   const int active = settings.active < 0 ? N : settings.active;
-  LinearizedProblem<N> current = linearize(*state);
+  Problem current = linearize(*state);
   double lambda = 0.0;
   int iterations = 0;
   while (iterations < settings.max_iterations && current.residuals >= settings.min_residuals) {
@@ -55,7 +62,7 @@ int MinimizeLevenbergMarquardt(State* state, const Linearize& linearize, const R
     delta.head(active) = A.ldlt().solve(-current.g.head(active));
     if (!delta.allFinite()) break;
     const State candidate = retract(*state, delta);
-    LinearizedProblem<N> next = linearize(candidate);
+    Problem next = linearize(candidate);
     const bool valid = next.residuals >= settings.min_residuals && std::isfinite(next.cost);
     const double change = valid ? (next.cost - current.cost) / current.cost : 1.0;
     if (valid && next.cost < current.cost) {
@@ -69,6 +76,7 @@ int MinimizeLevenbergMarquardt(State* state, const Linearize& linearize, const R
       lambda = lambda == 0.0 ? 0.2 : 4.0 * lambda;
     }
   }
+  if (final_problem != nullptr) *final_problem = std::move(current);
   return iterations;
 }
 

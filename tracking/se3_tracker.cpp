@@ -17,6 +17,12 @@ namespace {
 
 constexpr std::size_t kBlockSize = 2048;  // points per deterministic partial sum
 
+// A linearisation that keeps the level's evaluation (statistics included), so that the state
+// the optimisation ends on need not be evaluated again.
+struct EvaluatedProblem : LinearizedProblem<8> {
+  Se3Tracker::LevelEvaluation evaluation;
+};
+
 }  // namespace
 
 std::string ToString(TrackingStatus status) {
@@ -124,10 +130,12 @@ double Se3Tracker::Cost(const LevelEvaluation& e, const State& s,
 }
 
 int Se3Tracker::OptimizeLevel(const TrackingReference& reference, const Frame& frame, int level,
-                              int max_iterations, const AffineBrightness& prior, State* state) {
+                              int max_iterations, const AffineBrightness& prior, State* state,
+                              LevelEvaluation* final_evaluation) {
   const auto linearize = [&](const State& s) {
-    const LevelEvaluation e = EvaluateLevel(reference, frame, level, s.T_frame_kf, s.affine);
-    LinearizedProblem<8> problem;
+    EvaluatedProblem problem;
+    problem.evaluation = EvaluateLevel(reference, frame, level, s.T_frame_kf, s.affine);
+    const LevelEvaluation& e = problem.evaluation;
     problem.residuals = e.in_view;
     problem.cost = Cost(e, s, prior);
     if (e.in_view == 0) return problem;
@@ -156,13 +164,16 @@ int Se3Tracker::OptimizeLevel(const TrackingReference& reference, const Frame& f
       20,
       static_cast<int>(options_.min_usage * static_cast<double>(reference.Level(level).Size())));
   settings.active = options_.estimate_affine ? 8 : 6;
-  return MinimizeLevenbergMarquardt<8>(state, linearize, retract, settings);
+  EvaluatedProblem final_problem;
+  const int iterations =
+      MinimizeLevenbergMarquardt<8>(state, linearize, retract, settings, &final_problem);
+  *final_evaluation = std::move(final_problem.evaluation);
+  return iterations;
 }
 
-TrackingResult Se3Tracker::Finish(const TrackingReference& reference, const Frame& frame,
-                                  const State& state) {
+TrackingResult Se3Tracker::Finish(const TrackingReference& reference, const State& state,
+                                  const LevelEvaluation& e) {
   const int level = std::min(options_.finest_level, reference.NumLevels() - 1);
-  const LevelEvaluation e = EvaluateLevel(reference, frame, level, state.T_frame_kf, state.affine);
   TrackingResult result;
   result.T_kf_frame = state.T_frame_kf.Inverse();
   result.affine = state.affine;
@@ -200,12 +211,13 @@ TrackingResult Se3Tracker::TrackFrom(const TrackingReference& reference, const F
   const AffineBrightness prior = state.affine;
   const int finest = std::min(options_.finest_level, reference.NumLevels() - 1);
   std::array<int, kMaxPyramidLevels> iterations{};
+  LevelEvaluation finest_evaluation;
   for (int level = reference.NumLevels() - 1; level >= finest; --level) {
-    iterations[static_cast<std::size_t>(level)] =
-        OptimizeLevel(reference, frame, level,
-                      MaxIterationsForLevel(options_.max_iterations, level), prior, &state);
+    iterations[static_cast<std::size_t>(level)] = OptimizeLevel(
+        reference, frame, level, MaxIterationsForLevel(options_.max_iterations, level), prior,
+        &state, &finest_evaluation);
   }
-  TrackingResult result = Finish(reference, frame, state);
+  TrackingResult result = Finish(reference, state, finest_evaluation);
   result.stats.iterations = iterations;
   return result;
 }
@@ -229,9 +241,8 @@ TrackingResult Se3Tracker::Track(const TrackingReference& reference, const Frame
   const SE3d* best_candidate = nullptr;
   for (const SE3d& candidate : candidates) {
     State state{candidate.Inverse(), prior};
-    OptimizeLevel(reference, frame, coarsest, options_.hypothesis_iterations, prior, &state);
-    const LevelEvaluation e =
-        EvaluateLevel(reference, frame, coarsest, state.T_frame_kf, state.affine);
+    LevelEvaluation e;
+    OptimizeLevel(reference, frame, coarsest, options_.hypothesis_iterations, prior, &state, &e);
     const double cost =
         Cost(e, state, prior) /
         std::max(1e-9, e.in_view / static_cast<double>(reference.Level(coarsest).Size()));

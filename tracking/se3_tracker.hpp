@@ -103,9 +103,14 @@ class Se3Tracker {
     AffineBrightness affine;
   };
   double Cost(const LevelEvaluation& e, const State& s, const AffineBrightness& prior) const;
+  /// Optimises `state` on `level`; `final_evaluation` receives the level's evaluation at the
+  /// returned state.
   int OptimizeLevel(const TrackingReference& reference, const Frame& frame, int level,
-                    int max_iterations, const AffineBrightness& prior, State* state);
-  TrackingResult Finish(const TrackingReference& reference, const Frame& frame, const State& state);
+                    int max_iterations, const AffineBrightness& prior, State* state,
+                    LevelEvaluation* final_evaluation);
+  /// The result at `state` from `e`, its evaluation on the finest tracked level.
+  TrackingResult Finish(const TrackingReference& reference, const State& state,
+                        const LevelEvaluation& e);
 
   Se3TrackerOptions options_;
   std::vector<LevelEvaluation> block_sums_;  // scratch, one per block of points

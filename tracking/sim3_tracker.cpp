@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "core/check.hpp"
 #include "core/normal_equations.hpp"
@@ -46,6 +47,12 @@ struct Evaluation {
   int depth_residuals = 0;
   double sum_sq_residual = 0.0;
   double sum_gradient_sq = 0.0;
+};
+
+// A linearisation that keeps the level's evaluation: the finest level's, at the state the
+// optimisation ends on, gives the statistics and the information matrix.
+struct EvaluatedProblem : LinearizedProblem<kParams> {
+  Evaluation evaluation;
 };
 
 Evaluation EvaluateLevel(const Sim3TrackerOptions& options, const ReferenceLevel& points,
@@ -144,8 +151,9 @@ Sim3TrackingResult Sim3Tracker::Track(const TrackingReference& reference,
     const PyramidLevel& image = other.Keyframe().Level(level);
     const PinholeCamera& K = other.Keyframe().Camera(level);
     const auto linearize = [&](const State& s) {
-      const Evaluation e = EvaluateLevel(options_, points, image, K, depth, s);
-      LinearizedProblem<kParams> problem;
+      EvaluatedProblem problem;
+      problem.evaluation = EvaluateLevel(options_, points, image, K, depth, s);
+      const Evaluation& e = problem.evaluation;
       problem.residuals = e.in_view;
       if (e.in_view == 0) return problem;
       const double n = e.in_view;
@@ -176,15 +184,16 @@ Sim3TrackingResult Sim3Tracker::Track(const TrackingReference& reference,
     settings.min_residuals =
         std::max(20, static_cast<int>(options_.min_usage * static_cast<float>(points.Size())));
     settings.active = options_.estimate_affine ? kParams : 7;
+    EvaluatedProblem final_problem;
     try {
       result.stats.iterations[static_cast<std::size_t>(level)] =
-          MinimizeLevenbergMarquardt<kParams>(&state, linearize, retract, settings);
+          MinimizeLevenbergMarquardt<kParams>(&state, linearize, retract, settings, &final_problem);
     } catch (const std::invalid_argument&) {
       // A step produced a non-positive or non-finite scale: divergence, reported below.
       result.stats.diverged = true;
       break;
     }
-    if (level == finest) last = EvaluateLevel(options_, points, image, K, depth, state);
+    if (level == finest) last = std::move(final_problem.evaluation);
   }
   result.S_ref_other = state.S_other_ref.Inverse();
   result.affine = state.affine;
