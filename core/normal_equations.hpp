@@ -51,7 +51,19 @@ struct BlockAccumulator {
 
   void Add(const Eigen::Matrix<float, N, 1>& J, float r, float w, float robust_cost) {
     const Eigen::Matrix<float, N, 1> w_J = w * J;
-    H.noalias() += w_J * J.transpose();
+    // Column by column (inlined and vectorised, unlike Eigen's outer product here), and only
+    // down to the first multiple of 4 rows that covers the upper triangle: FlushInto reads
+    // nothing else. Every entry written gets the product and sum a full outer product gives.
+    constexpr int kQuarter = N < 4 ? N : 4, kHalf = N < 8 ? N : 8;
+    for (int j = 0; j < N; ++j) {
+      if (j < kQuarter) {
+        H.col(j).template head<kQuarter>() += w_J.template head<kQuarter>() * J[j];
+      } else if (j < kHalf) {
+        H.col(j).template head<kHalf>() += w_J.template head<kHalf>() * J[j];
+      } else {
+        H.col(j) += w_J * J[j];
+      }
+    }
     g.noalias() += r * w_J;
     cost += robust_cost;
     ++count;
