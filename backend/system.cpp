@@ -58,13 +58,25 @@ void SystemOptions::Check() const {
               "must be >= 1");
 }
 
+namespace {
+
+// The options with the tracking references' finest level set to the finest level a tracker
+// reads (finer levels are never built).
+SystemOptions WithReferenceLevels(SystemOptions options) {
+  options.reference.finest_level =
+      std::min(options.tracker.finest_level, options.backend.alignment.finest_level);
+  return options;
+}
+
+}  // namespace
+
 System::System(const PinholeCamera& camera, const SystemOptions& options)
     : camera_(camera),
-      options_(options),
+      options_(WithReferenceLevels(options)),
       tracker_(options.tracker),
-      mapper_(camera, options.depth, options.update_direction, options.reference,
+      mapper_(camera, options.depth, options.update_direction, options_.reference,
               options.recent_keyframes),
-      backend_(options.backend, KeyframeBuildOptions{camera, options.pyramid, options.reference}),
+      backend_(options.backend, KeyframeBuildOptions{camera, options.pyramid, options_.reference}),
       place_(Vocabulary::Default(), options.loop_closure.place),
       loop_closer_(options.loop_closure, &place_, camera),
       relocalizer_(options.relocalization, camera) {

@@ -210,6 +210,9 @@ TrackingResult Se3Tracker::TrackFrom(const TrackingReference& reference, const F
   State state{T_kf_frame.Inverse(), options_.estimate_affine ? affine_guess : AffineBrightness{}};
   const AffineBrightness prior = state.affine;
   const int finest = std::min(options_.finest_level, reference.NumLevels() - 1);
+  CheckArgument(reference.FinestLevel() <= finest,
+                "Se3Tracker: the reference has no points on the tracker's finest level "
+                "(TrackingReferenceOptions::finest_level)");
   std::array<int, kMaxPyramidLevels> iterations{};
   LevelEvaluation finest_evaluation;
   for (int level = reference.NumLevels() - 1; level >= finest; --level) {

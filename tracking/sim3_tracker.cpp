@@ -143,6 +143,9 @@ Sim3TrackingResult Sim3Tracker::Track(const TrackingReference& reference,
               options_.estimate_affine ? affine_guess : AffineBrightness{}};
   const AffineBrightness prior = state.affine;
   const int finest = std::min(options_.finest_level, reference.NumLevels() - 1);
+  CheckArgument(reference.FinestLevel() <= finest && other.FinestLevel() <= finest,
+                "Sim3Tracker: a reference has no points on the tracker's finest level "
+                "(TrackingReferenceOptions::finest_level)");
   Sim3TrackingResult result;
   Evaluation last;
   for (int level = reference.NumLevels() - 1; level >= finest; --level) {

@@ -1,8 +1,11 @@
 #include "tracking/tracking_reference.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "core/check.hpp"
+#include "tracking/tracking_result.hpp"
 
 namespace parallax {
 namespace {
@@ -18,34 +21,61 @@ void AddPoint(ReferenceLevel* level, const PinholeCamera& camera, const PyramidL
   level->intensity.push_back(image.intensity(x, y));
 }
 
+// Inverse-variance sums of the finer level's points in each pixel of the next coarser level
+// (2x2 aggregation), added in the order the points come.
+class CoarseSums {
+ public:
+  CoarseSums(int width, int height)
+      : width_(width),
+        height_(height),
+        sum_w_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0.0),
+        sum_wd_(sum_w_.size(), 0.0) {}
+
+  void Add(int fine_x, int fine_y, float idepth, float variance) {
+    const int x = fine_x / 2, y = fine_y / 2;
+    if (x >= width_ || y >= height_) return;  // odd trailing row/column has no parent
+    const std::size_t index = Index(x, y);
+    const double weight = 1.0 / variance;
+    sum_w_[index] += weight;
+    sum_wd_[index] += weight * idepth;
+  }
+
+  // The coarse level's points: one per pixel with a contribution.
+  ReferenceLevel Emit(const Frame& frame, int coarse_level) const {
+    const PyramidLevel& image = frame.Level(coarse_level);
+    const PinholeCamera& camera = frame.Camera(coarse_level);
+    ReferenceLevel coarse;
+    // The 1-pixel border has no gradient (pyramid convention), so it cannot constrain tracking.
+    for (int y = 1; y < height_ - 1; ++y) {
+      for (int x = 1; x < width_ - 1; ++x) {
+        const std::size_t index = Index(x, y);
+        if (sum_w_[index] <= 0.0) continue;
+        AddPoint(&coarse, camera, image, x, y, static_cast<float>(sum_wd_[index] / sum_w_[index]),
+                 static_cast<float>(1.0 / sum_w_[index]));
+      }
+    }
+    return coarse;
+  }
+
+ private:
+  std::size_t Index(int x, int y) const {
+    return static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
+           static_cast<std::size_t>(x);
+  }
+
+  int width_, height_;
+  std::vector<double> sum_w_, sum_wd_;
+};
+
 // Level l+1 from level l: inverse-variance weighted 2x2 aggregation.
 ReferenceLevel Coarsen(const ReferenceLevel& fine, const Frame& frame, int coarse_level) {
   const PyramidLevel& image = frame.Level(coarse_level);
-  const int w = image.Width(), h = image.Height();
-  std::vector<double> sum_w(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), 0.0);
-  std::vector<double> sum_wd(sum_w.size(), 0.0);
+  CoarseSums sums(image.Width(), image.Height());
   for (std::size_t i = 0; i < fine.Size(); ++i) {
-    const int x = static_cast<int>(fine.u[i]) / 2, y = static_cast<int>(fine.v[i]) / 2;
-    if (x >= w || y >= h) continue;  // odd trailing row/column has no parent
-    const auto index =
-        static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-    const double weight = 1.0 / fine.variance[i];
-    sum_w[index] += weight;
-    sum_wd[index] += weight * fine.idepth[i];
+    sums.Add(static_cast<int>(fine.u[i]), static_cast<int>(fine.v[i]), fine.idepth[i],
+             fine.variance[i]);
   }
-  ReferenceLevel coarse;
-  const PinholeCamera& camera = frame.Camera(coarse_level);
-  // The 1-pixel border has no gradient (pyramid convention), so it cannot constrain tracking.
-  for (int y = 1; y < h - 1; ++y) {
-    for (int x = 1; x < w - 1; ++x) {
-      const auto index =
-          static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-      if (sum_w[index] <= 0.0) continue;
-      AddPoint(&coarse, camera, image, x, y, static_cast<float>(sum_wd[index] / sum_w[index]),
-               static_cast<float>(1.0 / sum_w[index]));
-    }
-  }
-  return coarse;
+  return sums.Emit(frame, coarse_level);
 }
 
 // Keeps `budget` of the level's points spread evenly over their raster order, so that the
@@ -69,6 +99,8 @@ void TrackingReferenceOptions::Check() const {
   CheckOption(std::isfinite(min_gradient) && min_gradient >= 0.0f, "TrackingReferenceOptions",
               "min_gradient", "must be >= 0");
   CheckOption(border >= 1, "TrackingReferenceOptions", "border", "must be >= 1");
+  CheckOption(finest_level >= 0 && finest_level < kMaxPyramidLevels, "TrackingReferenceOptions",
+              "finest_level", "must be in [0, 7]");
 }
 
 TrackingReference::TrackingReference(std::shared_ptr<const Frame> keyframe, const ImageF& idepth,
@@ -88,26 +120,41 @@ TrackingReference::TrackingReference(std::shared_ptr<const Frame> keyframe, cons
     return d > 0.0f && var > 0.0f && std::isfinite(d) && std::isfinite(var) &&
            max_gradient(x, y) >= options.min_gradient;
   };
-  std::size_t count = 0;
-  for (int y = b; y < level0.Height() - b; ++y) {
-    for (int x = b; x < level0.Width() - b; ++x) count += usable(x, y);
-  }
+  finest_level_ = std::min(options.finest_level, keyframe_->NumLevels() - 1);
+  // Level 0's points are stored only when a tracker reads them; level 1 is summed from them
+  // as they are found, in the same order as from stored ones.
+  const bool keep_level0 = finest_level_ == 0;
   ReferenceLevel points;
-  points.Reserve(count);
+  if (keep_level0) {
+    std::size_t count = 0;
+    for (int y = b; y < level0.Height() - b; ++y) {
+      for (int x = b; x < level0.Width() - b; ++x) count += usable(x, y);
+    }
+    points.Reserve(count);
+  }
+  std::optional<CoarseSums> level1;
+  if (keyframe_->NumLevels() > 1)
+    level1.emplace(keyframe_->Level(1).Width(), keyframe_->Level(1).Height());
   double idepth_sum = 0.0;
+  std::size_t count = 0;
   for (int y = b; y < level0.Height() - b; ++y) {
     for (int x = b; x < level0.Width() - b; ++x) {
       if (!usable(x, y)) continue;
-      AddPoint(&points, keyframe_->Camera(0), level0, x, y, idepth(x, y), variance(x, y));
+      if (keep_level0) {
+        AddPoint(&points, keyframe_->Camera(0), level0, x, y, idepth(x, y), variance(x, y));
+      }
+      if (level1) level1->Add(x, y, idepth(x, y), variance(x, y));
       idepth_sum += idepth(x, y);
+      ++count;
     }
   }
-  mean_idepth_ =
-      points.Size() ? static_cast<float>(idepth_sum / static_cast<double>(points.Size())) : 0.0f;
+  mean_idepth_ = count ? static_cast<float>(idepth_sum / static_cast<double>(count)) : 0.0f;
   levels_.push_back(std::move(points));
-  for (int l = 1; l < keyframe_->NumLevels(); ++l) {
+  if (level1) levels_.push_back(level1->Emit(*keyframe_, 1));
+  for (int l = 2; l < keyframe_->NumLevels(); ++l) {
     levels_.push_back(Coarsen(levels_.back(), *keyframe_, l));
   }
+  for (int l = 1; l < finest_level_; ++l) levels_[static_cast<std::size_t>(l)] = ReferenceLevel{};
   for (ReferenceLevel& level : levels_) ThinLevel(options.max_points_per_level, &level);
 }
 

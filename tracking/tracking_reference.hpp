@@ -22,6 +22,11 @@ struct TrackingReferenceOptions {
   /// cost scale with it; off by default because fewer points track fast turns worse
   /// (docs/benchmarks.md, "Tracking point budget").
   std::size_t max_points_per_level = 0;
+  /// Levels finer than this are left empty: building and storing level 0 (80-170k points on
+  /// real texture) is wasted when the trackers stop at level 1. The coarser levels are the
+  /// same either way. System sets it to the finest level its trackers use; a tracker asked
+  /// for a finer level than a reference has throws.
+  int finest_level = 0;
 
   void Check() const;
 };
@@ -69,11 +74,14 @@ class TrackingReference {
   const ReferenceLevel& Level(int level) const { return levels_[static_cast<std::size_t>(level)]; }
   /// Mean inverse depth of the level-0 points (1 after scale normalisation).
   float MeanIdepth() const { return mean_idepth_; }
+  /// The finest level with points (levels below it are empty by construction).
+  int FinestLevel() const { return finest_level_; }
 
  private:
   std::shared_ptr<const Frame> keyframe_;
   std::vector<ReferenceLevel> levels_;
   float mean_idepth_ = 0.0f;
+  int finest_level_ = 0;
 };
 
 }  // namespace parallax

@@ -325,6 +325,35 @@ TEST_F(Se3TrackerRenderTest, PointBudgetThinsEveryLevelEvenly) {
   EXPECT_LT(ComparePoses(result.T_kf_frame, TrueKfFrame(10)).rotation_deg, 0.1);
 }
 
+// A reference built from level 1 on has exactly the coarse levels of a full one (they are
+// summed from level 0's pixels in the same order) and an empty level 0; a tracker that would
+// read level 0 refuses it, one that stops at level 1 tracks the same pose bit for bit.
+TEST_F(Se3TrackerRenderTest, ReferenceFromLevelOneHasTheSameCoarseLevels) {
+  const TrackingReference full(keyframe_->frame, keyframe_->idepth, keyframe_->variance);
+  TrackingReferenceOptions options;
+  options.finest_level = 1;
+  const TrackingReference coarse(keyframe_->frame, keyframe_->idepth, keyframe_->variance, options);
+  ASSERT_EQ(coarse.NumLevels(), full.NumLevels());
+  EXPECT_EQ(coarse.FinestLevel(), 1);
+  EXPECT_EQ(coarse.Level(0).Size(), 0u);
+  ASSERT_GT(full.Level(0).Size(), 0u);
+  for (int l = 1; l < full.NumLevels(); ++l) {
+    for (const auto field : kReferenceLevelFields) {
+      EXPECT_EQ(coarse.Level(l).*field, full.Level(l).*field) << "level " << l;
+    }
+  }
+  EXPECT_EQ(coarse.MeanIdepth(), full.MeanIdepth());
+  const auto frame = test::RenderTestFrame(*scene_, Pose(10), 1);
+  const SE3d guess = Perturb(TrueKfFrame(10), 3.0, 0.05, 0);
+  Se3Tracker tracker;  // finest level 1
+  EXPECT_EQ(tracker.TrackFrom(coarse, *frame, guess, {}).T_kf_frame.Matrix(),
+            tracker.TrackFrom(full, *frame, guess, {}).T_kf_frame.Matrix());
+  Se3TrackerOptions level0;
+  level0.finest_level = 0;
+  Se3Tracker fine(level0);
+  EXPECT_THROW(fine.TrackFrom(coarse, *frame, guess, {}), std::invalid_argument);
+}
+
 TEST(TrackingReference, CoarseLevelsAreInverseVarianceWeighted) {
   ImageU8 image(64, 48);
   for (int y = 0; y < 48; ++y) {
