@@ -194,18 +194,23 @@ int DepthFilter::Regularize(InverseDepthMap* map) const {
   in.inv_var.assign(map->valid.size(), 0.0f);
   in.support.assign(map->valid.size(), 0.0f);
   in.vote.assign(map->valid.size(), 0.0f);
-  int diverged = 0;
-  for (std::size_t i = 0; i < map->valid.size(); ++i) {
-    if (!map->valid[i]) continue;
-    if (!HealthyEstimate(map->idepth[i], map->variance[i])) {
-      Invalidate(map, i);
-      ++diverged;
-      continue;
+  // Per pixel, so rows run in parallel; the count is summed in row order.
+  std::vector<int> diverged_in_row(Idx(h), 0);
+  tbb::parallel_for(0, h, [&](int y) {
+    for (std::size_t i = map->Index(0, y), end = i + Idx(w); i < end; ++i) {
+      if (!map->valid[i]) continue;
+      if (!HealthyEstimate(map->idepth[i], map->variance[i])) {
+        Invalidate(map, i);
+        ++diverged_in_row[Idx(y)];
+        continue;
+      }
+      in.inv_var[i] = 1.0f / map->variance[i];
+      in.support[i] = map->validity[i];
+      in.vote[i] = map->observations[i] > 0 ? map->validity[i] : 0.0f;
     }
-    in.inv_var[i] = 1.0f / map->variance[i];
-    in.support[i] = map->validity[i];
-    in.vote[i] = map->observations[i] > 0 ? map->validity[i] : 0.0f;
-  }
+  });
+  int diverged = 0;
+  for (const int n : diverged_in_row) diverged += n;
   // Inverse variance, decaying mildly with distance (scale-free form of LSD's
   // 1 / (var + dist^2 * REG_DIST_VAR)).
   for (int dy = -2; dy <= 2; ++dy) {
@@ -229,9 +234,12 @@ int DepthFilter::Regularize(InverseDepthMap* map) const {
                 HealthyEstimate(r.idepth, r.variance);
     }
   });
-  for (std::size_t i = 0; i < keep.size(); ++i) {
-    if (map->valid[i] && !keep[i]) Invalidate(map, i);
-  }
+  // After every window has read its inputs: the removals change no other pixel's result.
+  tbb::parallel_for(0, h, [&](int y) {
+    for (std::size_t i = map->Index(0, y), end = i + Idx(w); i < end; ++i) {
+      if (map->valid[i] && !keep[i]) Invalidate(map, i);
+    }
+  });
   return diverged;
 }
 
