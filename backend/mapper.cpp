@@ -33,10 +33,10 @@ void Mapper::Restore(std::unique_ptr<InverseDepthMap> map,
 }
 
 void Mapper::PublishReference() {
-  ImageF idepth, variance;
-  map_->ExportSmoothed(&idepth, &variance);
-  reference_ = std::make_shared<const TrackingReference>(map_->KeyframePtr(), idepth, variance,
-                                                         reference_options_);
+  const ReferenceDepth smoothed{map_->Width(), map_->Height(), map_->idepth_smoothed.data(),
+                                map_->variance_smoothed.data(), map_->valid.data()};
+  reference_ =
+      std::make_shared<const TrackingReference>(map_->KeyframePtr(), smoothed, reference_options_);
 }
 
 DepthUpdateStats Mapper::Update(const Frame& frame, const SE3d& T_kf_update,

@@ -1,5 +1,7 @@
 #include "tracking/tracking_reference.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -106,46 +108,70 @@ void TrackingReferenceOptions::Check() const {
 TrackingReference::TrackingReference(std::shared_ptr<const Frame> keyframe, const ImageF& idepth,
                                      const ImageF& variance,
                                      const TrackingReferenceOptions& options)
+    : TrackingReference(
+          std::move(keyframe),
+          ReferenceDepth{idepth.Width(), idepth.Height(), idepth.Data(),
+                         variance.Width() == idepth.Width() && variance.Height() == idepth.Height()
+                             ? variance.Data()
+                             : nullptr,
+                         nullptr},
+          options) {}
+
+TrackingReference::TrackingReference(std::shared_ptr<const Frame> keyframe,
+                                     const ReferenceDepth& depth,
+                                     const TrackingReferenceOptions& options)
     : keyframe_(std::move(keyframe)) {
   options.Check();
   CheckArgument(keyframe_ != nullptr, "TrackingReference: keyframe is null");
   const PyramidLevel& level0 = keyframe_->Level(0);
-  CheckArgument(idepth.Width() == level0.Width() && idepth.Height() == level0.Height() &&
-                    variance.Width() == level0.Width() && variance.Height() == level0.Height(),
+  CheckArgument(depth.width == level0.Width() && depth.height == level0.Height() &&
+                    depth.idepth != nullptr && depth.variance != nullptr,
                 "TrackingReference: idepth/variance images must have the keyframe's size");
-  const ImageF& max_gradient = keyframe_->MaxGradient();
-  const int b = options.border;
-  const auto usable = [&](int x, int y) {
-    const float d = idepth(x, y), var = variance(x, y);
-    return d > 0.0f && var > 0.0f && std::isfinite(d) && std::isfinite(var) &&
-           max_gradient(x, y) >= options.min_gradient;
-  };
   finest_level_ = std::min(options.finest_level, keyframe_->NumLevels() - 1);
-  // Level 0's points are stored only when a tracker reads them; level 1 is summed from them
-  // as they are found, in the same order as from stored ones.
-  const bool keep_level0 = finest_level_ == 0;
-  ReferenceLevel points;
-  if (keep_level0) {
-    std::size_t count = 0;
-    for (int y = b; y < level0.Height() - b; ++y) {
-      for (int x = b; x < level0.Width() - b; ++x) count += usable(x, y);
-    }
-    points.Reserve(count);
-  }
   std::optional<CoarseSums> level1;
-  if (keyframe_->NumLevels() > 1)
+  if (keyframe_->NumLevels() > 1) {
     level1.emplace(keyframe_->Level(1).Width(), keyframe_->Level(1).Height());
+  }
+  // Level 0's points are stored only when a tracker reads them; level 1 is summed from them
+  // as they are found. One task per pair of level-0 rows, which only it maps to: each level-1
+  // pixel gets its contributions in raster order, as from a serial scan.
+  const bool keep_level0 = finest_level_ == 0;
+  const ImageF& max_gradient = keyframe_->MaxGradient();
+  const int b = options.border, w = level0.Width(), h = level0.Height();
+  struct RowPairScan {
+    double idepth_sum = 0.0;
+    std::size_t count = 0;
+    ReferenceLevel points;
+  };
+  std::vector<RowPairScan> scans(static_cast<std::size_t>((h + 1) / 2));
+  tbb::parallel_for(0, (h + 1) / 2, [&](int pair) {
+    RowPairScan& scan = scans[static_cast<std::size_t>(pair)];
+    for (int y = std::max(2 * pair, b); y < std::min(2 * pair + 2, h - b); ++y) {
+      const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
+      for (int x = b; x < w - b; ++x) {
+        const std::size_t i = row + static_cast<std::size_t>(x);
+        const float d = depth.idepth[i], var = depth.variance[i];
+        const bool usable = (depth.valid == nullptr || depth.valid[i] != 0) && d > 0.0f &&
+                            var > 0.0f && std::isfinite(d) && std::isfinite(var) &&
+                            max_gradient(x, y) >= options.min_gradient;
+        if (!usable) continue;
+        if (keep_level0) AddPoint(&scan.points, keyframe_->Camera(0), level0, x, y, d, var);
+        if (level1) level1->Add(x, y, d, var);
+        scan.idepth_sum += d;
+        ++scan.count;
+      }
+    }
+  });
+  ReferenceLevel points;
   double idepth_sum = 0.0;
   std::size_t count = 0;
-  for (int y = b; y < level0.Height() - b; ++y) {
-    for (int x = b; x < level0.Width() - b; ++x) {
-      if (!usable(x, y)) continue;
-      if (keep_level0) {
-        AddPoint(&points, keyframe_->Camera(0), level0, x, y, idepth(x, y), variance(x, y));
-      }
-      if (level1) level1->Add(x, y, idepth(x, y), variance(x, y));
-      idepth_sum += idepth(x, y);
-      ++count;
+  for (const RowPairScan& scan : scans) {
+    idepth_sum += scan.idepth_sum;
+    count += scan.count;
+    if (!keep_level0) continue;
+    for (const auto field : kReferenceLevelFields) {
+      (points.*field)
+          .insert((points.*field).end(), (scan.points.*field).begin(), (scan.points.*field).end());
     }
   }
   mean_idepth_ = count ? static_cast<float>(idepth_sum / static_cast<double>(count)) : 0.0f;

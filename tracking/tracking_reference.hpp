@@ -3,6 +3,7 @@
 // pyramid level, built once per keyframe and reused for every tracked frame.
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -56,6 +57,16 @@ inline void ReferenceLevel::Reserve(std::size_t n) {
   for (const auto field : kReferenceLevelFields) (this->*field).reserve(n);
 }
 
+/// Keyframe-sized (level 0) inverse depth and variance, row-major, read during construction
+/// only; pixels where `valid` (optional) is 0 are not used.
+struct ReferenceDepth {
+  int width = 0;
+  int height = 0;
+  const float* idepth = nullptr;
+  const float* variance = nullptr;
+  const std::uint8_t* valid = nullptr;
+};
+
 /// Semi-dense points of a keyframe for tracking. Level 0 takes every pixel with valid
 /// inverse depth and enough gradient; level l+1 combines the (up to four) level-l points of
 /// each 2x2 block by inverse-variance weighting: idepth = sum(d_i/v_i) / sum(1/v_i),
@@ -67,6 +78,11 @@ class TrackingReference {
   /// keyframe.
   TrackingReference(std::shared_ptr<const Frame> keyframe, const ImageF& idepth,
                     const ImageF& variance, const TrackingReferenceOptions& options = {});
+  /// The same from arrays (a depth map's, without exporting it to images). Level 0 is scanned
+  /// in parallel; the points and coarse levels do not depend on the thread count, MeanIdepth
+  /// is summed per pair of rows.
+  TrackingReference(std::shared_ptr<const Frame> keyframe, const ReferenceDepth& depth,
+                    const TrackingReferenceOptions& options = {});
 
   const Frame& Keyframe() const { return *keyframe_; }
   const std::shared_ptr<const Frame>& KeyframePtr() const { return keyframe_; }
