@@ -41,7 +41,11 @@ inline bool EvaluatePhotometric(const PyramidLevel& frame, const LevelCamera& ca
                                 float ray_y, float idepth, float idepth_variance,
                                 float ref_intensity, float gain, float offset,
                                 float pixel_noise_variance, PhotometricTerm* out) {
-  const Eigen::Vector3f Mray = M * Eigen::Vector3f(ray_x, ray_y, 1.0f);
+  // Sums written out (the order Eigen's fixed-size product used on the generic x86-64 build),
+  // so that the SSE2 twin (tracking/photometric_batch.cpp) can repeat them exactly.
+  const Eigen::Vector3f Mray(M(0, 0) * ray_x + (M(0, 1) * ray_y + M(0, 2)),
+                             M(1, 0) * ray_x + (M(1, 1) * ray_y + M(1, 2)),
+                             M(2, 0) * ray_x + (M(2, 1) * ray_y + M(2, 2)));
   const Eigen::Vector3f p_scaled = Mray + idepth * t;  // = idepth * p
   if (!(p_scaled.z() > 1e-6f * idepth)) return false;
   const float inv_z = 1.0f / p_scaled.z();  // = 1 / (idepth * z)
@@ -66,7 +70,9 @@ inline bool EvaluatePhotometric(const PyramidLevel& frame, const LevelCamera& ca
   out->p = Eigen::Vector3f(xn * z, yn * z, z);
   out->residual = I - (gain * ref_intensity + offset);
   // d p / d idepth = -(p - t) / idepth = -M ray / idepth^2.
-  const float dr_dd = -out->dr_dp.dot(Mray) / (idepth * idepth);
+  const Eigen::Vector3f& d = out->dr_dp;
+  const float dr_dd =
+      -(d.x() * Mray.x() + (d.y() * Mray.y() + d.z() * Mray.z())) / (idepth * idepth);
   out->variance = pixel_noise_variance + dr_dd * dr_dd * idepth_variance;
   out->gradient_sq = gx * gx + gy * gy;
   return true;
