@@ -63,7 +63,7 @@ void Add(DepthUpdateStats* total, const DepthUpdateStats& s) {
 DepthFilter::DepthFilter(const DepthFilterOptions& options)
     : options_(options),
       converged_sigma_sq_(options.converged_relative_sigma * options.converged_relative_sigma),
-      converged_recheck_(static_cast<std::size_t>(std::max(1, options.converged_recheck))) {
+      converged_recheck_(static_cast<std::uint32_t>(std::max(1, options.converged_recheck))) {
   options_.Check();
 }
 
@@ -82,7 +82,10 @@ void DepthFilter::UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search
     ++stats->diverged;
     return;
   }
-  if (has_prior && Converged(*map, i) && (i + map->updates) % converged_recheck_ != 0) {
+  // In turn, one in converged_recheck_ of the converged estimates per update (a map has
+  // fewer than 2^32 - pixels updates, so the 32-bit sum does not wrap).
+  if (has_prior && Converged(*map, i) &&
+      (static_cast<std::uint32_t>(i) + map->updates) % converged_recheck_ != 0) {
     ++stats->converged_skipped;
     return;
   }

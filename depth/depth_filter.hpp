@@ -83,7 +83,7 @@ class DepthFilter {
   bool Converged(const InverseDepthMap& map, std::size_t i) const;
   DepthFilterOptions options_;
   float converged_sigma_sq_;
-  std::size_t converged_recheck_;
+  std::uint32_t converged_recheck_;  ///< 32-bit: the modulo per converged pixel is cheaper
 };
 
 }  // namespace parallax

@@ -1,5 +1,7 @@
 #include "depth/depth_map.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <cmath>
 #include <random>
 
@@ -109,12 +111,25 @@ std::size_t InverseDepthMap::NumEligible() const {
 }
 
 double InverseDepthMap::MeanSmoothedIdepth() const {
+  // Rows in parallel, their sums added in row order: the same value for any thread count.
+  std::vector<double> row_sum(static_cast<std::size_t>(height_), 0.0);
+  std::vector<std::size_t> row_count(row_sum.size(), 0);
+  tbb::parallel_for(0, height_, [&](int y) {
+    double sum = 0.0;
+    std::size_t n = 0;
+    for (std::size_t i = Index(0, y), end = i + static_cast<std::size_t>(width_); i < end; ++i) {
+      if (!valid[i]) continue;
+      sum += idepth_smoothed[i];
+      ++n;
+    }
+    row_sum[static_cast<std::size_t>(y)] = sum;
+    row_count[static_cast<std::size_t>(y)] = n;
+  });
   double sum = 0.0;
   std::size_t n = 0;
-  for (std::size_t i = 0; i < valid.size(); ++i) {
-    if (!valid[i]) continue;
-    sum += idepth_smoothed[i];
-    ++n;
+  for (std::size_t y = 0; y < row_sum.size(); ++y) {
+    sum += row_sum[y];
+    n += row_count[y];
   }
   return n ? sum / static_cast<double>(n) : 0.0;
 }
