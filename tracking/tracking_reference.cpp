@@ -12,15 +12,23 @@
 namespace parallax {
 namespace {
 
+// Writes point k of `level` (its arrays already hold k + 1 entries or more).
+void SetPoint(ReferenceLevel* level, std::size_t k, const PinholeCamera& camera,
+              const PyramidLevel& image, int x, int y, float idepth, float variance) {
+  level->u[k] = static_cast<float>(x);
+  level->v[k] = static_cast<float>(y);
+  level->ray_x[k] = static_cast<float>((x - camera.Cx()) / camera.Fx());
+  level->ray_y[k] = static_cast<float>((y - camera.Cy()) / camera.Fy());
+  level->idepth[k] = idepth;
+  level->variance[k] = variance;
+  level->intensity[k] = image.intensity(x, y);
+}
+
 void AddPoint(ReferenceLevel* level, const PinholeCamera& camera, const PyramidLevel& image, int x,
               int y, float idepth, float variance) {
-  level->u.push_back(static_cast<float>(x));
-  level->v.push_back(static_cast<float>(y));
-  level->ray_x.push_back(static_cast<float>((x - camera.Cx()) / camera.Fx()));
-  level->ray_y.push_back(static_cast<float>((y - camera.Cy()) / camera.Fy()));
-  level->idepth.push_back(idepth);
-  level->variance.push_back(variance);
-  level->intensity.push_back(image.intensity(x, y));
+  const std::size_t k = level->Size();
+  for (const auto field : kReferenceLevelFields) (level->*field).emplace_back();
+  SetPoint(level, k, camera, image, x, y, idepth, variance);
 }
 
 // Inverse-variance sums of the finer level's points in each pixel of the next coarser level
@@ -42,20 +50,32 @@ class CoarseSums {
     sum_wd_[index] += weight * idepth;
   }
 
-  // The coarse level's points: one per pixel with a contribution.
+  // The coarse level's points, one per pixel with a contribution, in raster order. Rows in
+  // parallel: counted, then written at their offsets.
   ReferenceLevel Emit(const Frame& frame, int coarse_level) const {
     const PyramidLevel& image = frame.Level(coarse_level);
     const PinholeCamera& camera = frame.Camera(coarse_level);
-    ReferenceLevel coarse;
     // The 1-pixel border has no gradient (pyramid convention), so it cannot constrain tracking.
-    for (int y = 1; y < height_ - 1; ++y) {
+    const int first_row = 1, end_row = std::max(1, height_ - 1);
+    std::vector<std::size_t> row_start(static_cast<std::size_t>(end_row) + 1, 0);
+    tbb::parallel_for(first_row, end_row, [&](int y) {
+      std::size_t n = 0;
+      for (int x = 1; x < width_ - 1; ++x) n += sum_w_[Index(x, y)] > 0.0;
+      row_start[static_cast<std::size_t>(y) + 1] = n;
+    });
+    for (std::size_t y = 1; y < row_start.size(); ++y) row_start[y] += row_start[y - 1];
+    ReferenceLevel coarse;
+    for (const auto field : kReferenceLevelFields) (coarse.*field).resize(row_start.back());
+    tbb::parallel_for(first_row, end_row, [&](int y) {
+      std::size_t k = row_start[static_cast<std::size_t>(y)];
       for (int x = 1; x < width_ - 1; ++x) {
         const std::size_t index = Index(x, y);
         if (sum_w_[index] <= 0.0) continue;
-        AddPoint(&coarse, camera, image, x, y, static_cast<float>(sum_wd_[index] / sum_w_[index]),
+        SetPoint(&coarse, k++, camera, image, x, y,
+                 static_cast<float>(sum_wd_[index] / sum_w_[index]),
                  static_cast<float>(1.0 / sum_w_[index]));
       }
-    }
+    });
     return coarse;
   }
 
