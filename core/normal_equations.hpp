@@ -3,6 +3,7 @@
 // that partial sums over blocks of points can be added in a fixed order (deterministic).
 
 #include <Eigen/Core>
+#include <algorithm>
 
 namespace parallax {
 
@@ -54,16 +55,14 @@ struct BlockAccumulator {
     // Column by column (inlined and vectorised, unlike Eigen's outer product here), and only
     // down to the first multiple of 4 rows that covers the upper triangle: FlushInto reads
     // nothing else. Every entry written gets the product and sum a full outer product gives.
-    constexpr int kQuarter = N < 4 ? N : 4, kHalf = N < 8 ? N : 8;
-    for (int j = 0; j < N; ++j) {
-      if (j < kQuarter) {
-        H.col(j).template head<kQuarter>() += w_J.template head<kQuarter>() * J[j];
-      } else if (j < kHalf) {
-        H.col(j).template head<kHalf>() += w_J.template head<kHalf>() * J[j];
-      } else {
-        H.col(j) += w_J * J[j];
-      }
+    constexpr int kFirst = std::min(N, 4), kSecond = std::min(N, 8);
+    for (int j = 0; j < kFirst; ++j) {
+      H.col(j).template head<kFirst>() += w_J.template head<kFirst>() * J[j];
     }
+    for (int j = kFirst; j < kSecond; ++j) {
+      H.col(j).template head<kSecond>() += w_J.template head<kSecond>() * J[j];
+    }
+    for (int j = kSecond; j < N; ++j) H.col(j) += w_J * J[j];
     g.noalias() += r * w_J;
     cost += robust_cost;
     ++count;
