@@ -24,6 +24,51 @@ struct EvaluatedProblem : LinearizedProblem<8> {
   Se3Tracker::LevelEvaluation evaluation;
 };
 
+// Points [first, end) of a level: four at a time (SSE2), then one by one, with the same
+// results either way (tracking/photometric_batch.hpp), added in point order.
+void EvaluateBlock(const PyramidLevel& image, const LevelCamera& camera,
+                   const PhotometricModel& model, const ReferenceLevel& points, float good_sq,
+                   std::size_t first, std::size_t end, Se3Tracker::LevelEvaluation* sum) {
+  BlockAccumulator<8> accumulator;
+  const auto add = [&](std::size_t i, const Eigen::Vector3f& dr_dp, const Eigen::Vector3f& p,
+                       float residual, float variance, float gradient_sq, const RobustWeight& w) {
+    Eigen::Matrix<float, 8, 1> J;
+    J.head<3>() = dr_dp;
+    J.segment<3>(3) = p.cross(dr_dp);
+    J[6] = -model.gain * points.intensity[i];
+    J[7] = -1.0f;
+    accumulator.Add(J, residual, w.weight, w.cost);
+    ++sum->in_view;
+    sum->good += residual * residual < good_sq * variance;
+    sum->sum_sq_residual += static_cast<double>(residual) * residual;
+    sum->sum_gradient_sq += gradient_sq;
+  };
+  const PhotometricPoints soa{points.ray_x.data(), points.ray_y.data(), points.idepth.data(),
+                              points.variance.data(), points.intensity.data()};
+  std::size_t i = first;
+  PhotometricBatch batch;
+  for (; i + 4 <= end; i += 4) {
+    EvaluatePhotometric4(image, camera, model, soa, i, &batch);
+    for (std::size_t lane = 0; lane < 4; ++lane) {
+      if ((batch.in_view & (1u << lane)) == 0) continue;
+      add(i + lane, {batch.dr_dp[0][lane], batch.dr_dp[1][lane], batch.dr_dp[2][lane]},
+          {batch.p[0][lane], batch.p[1][lane], batch.p[2][lane]}, batch.residual[lane],
+          batch.variance[lane], batch.gradient_sq[lane],
+          RobustWeight{batch.weight[lane], batch.cost[lane]});
+    }
+  }
+  PhotometricTerm term;
+  for (; i < end; ++i) {
+    if (EvaluatePhotometric(image, camera, model.M, model.t, points.ray_x[i], points.ray_y[i],
+                            points.idepth[i], points.variance[i], points.intensity[i], model.gain,
+                            model.offset, model.pixel_noise_variance, &term)) {
+      add(i, term.dr_dp, term.p, term.residual, term.variance, term.gradient_sq,
+          HuberWeight(term.residual, term.variance, model.huber_k));
+    }
+  }
+  accumulator.FlushInto(&sum->equations);
+}
+
 }  // namespace
 
 std::string ToString(TrackingStatus status) {
@@ -84,49 +129,9 @@ Se3Tracker::LevelEvaluation Se3Tracker::EvaluateLevel(const TrackingReference& r
   const std::size_t num_blocks = (points.Size() + kBlockSize - 1) / kBlockSize;
   block_sums_.assign(num_blocks, LevelEvaluation{});
   const PhotometricModel model{R, t, gain, offset, noise_var, k};
-  const PhotometricPoints soa{points.ray_x.data(), points.ray_y.data(), points.idepth.data(),
-                              points.variance.data(), points.intensity.data()};
   tbb::parallel_for(std::size_t{0}, num_blocks, [&](std::size_t block) {
-    LevelEvaluation& sum = block_sums_[block];
-    BlockAccumulator<8> accumulator;
-    const auto add = [&](std::size_t i, const Eigen::Vector3f& dr_dp, const Eigen::Vector3f& p,
-                         float residual, float variance, float gradient_sq, const RobustWeight& w) {
-      Eigen::Matrix<float, 8, 1> J;
-      J.head<3>() = dr_dp;
-      J.segment<3>(3) = p.cross(dr_dp);
-      J[6] = -gain * points.intensity[i];
-      J[7] = -1.0f;
-      accumulator.Add(J, residual, w.weight, w.cost);
-      ++sum.in_view;
-      sum.good += residual * residual < good_sq * variance;
-      sum.sum_sq_residual += static_cast<double>(residual) * residual;
-      sum.sum_gradient_sq += gradient_sq;
-    };
-    const std::size_t end = std::min(points.Size(), (block + 1) * kBlockSize);
-    std::size_t i = block * kBlockSize;
-    // Four points at a time (SSE2), then one by one; the same results either way
-    // (tracking/photometric_batch.hpp), added in point order.
-    PhotometricBatch batch;
-    for (; i + 4 <= end; i += 4) {
-      EvaluatePhotometric4(image, camera, model, soa, i, &batch);
-      for (std::size_t lane = 0; lane < 4; ++lane) {
-        if ((batch.in_view & (1u << lane)) == 0) continue;
-        add(i + lane, {batch.dr_dp[0][lane], batch.dr_dp[1][lane], batch.dr_dp[2][lane]},
-            {batch.p[0][lane], batch.p[1][lane], batch.p[2][lane]}, batch.residual[lane],
-            batch.variance[lane], batch.gradient_sq[lane],
-            RobustWeight{batch.weight[lane], batch.cost[lane]});
-      }
-    }
-    PhotometricTerm term;
-    for (; i < end; ++i) {
-      if (EvaluatePhotometric(image, camera, R, t, points.ray_x[i], points.ray_y[i],
-                              points.idepth[i], points.variance[i], points.intensity[i], gain,
-                              offset, noise_var, &term)) {
-        add(i, term.dr_dp, term.p, term.residual, term.variance, term.gradient_sq,
-            HuberWeight(term.residual, term.variance, k));
-      }
-    }
-    accumulator.FlushInto(&sum.equations);
+    EvaluateBlock(image, camera, model, points, good_sq, block * kBlockSize,
+                  std::min(points.Size(), (block + 1) * kBlockSize), &block_sums_[block]);
   });
   LevelEvaluation total;
   for (const LevelEvaluation& block : block_sums_) {  // fixed order: deterministic
