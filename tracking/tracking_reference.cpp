@@ -100,6 +100,54 @@ ReferenceLevel Coarsen(const ReferenceLevel& fine, const Frame& frame, int coars
   return sums.Emit(frame, coarse_level);
 }
 
+// What the level-0 pass gives: the points (when kept) and their inverse depths' sum.
+struct Level0Scan {
+  ReferenceLevel points;
+  double idepth_sum = 0.0;
+  std::size_t count = 0;
+};
+
+// Level 0's usable pixels: stored only when a tracker reads them (keep), summed into level 1
+// (when given) as they are found. One task per pair of level-0 rows, which only it maps to:
+// each level-1 pixel gets its contributions in raster order, as from a serial scan; the
+// tasks' results are joined in row order.
+Level0Scan ScanLevel0(const Frame& keyframe, const ReferenceDepth& depth,
+                      const TrackingReferenceOptions& options, bool keep, CoarseSums* level1) {
+  const PyramidLevel& level0 = keyframe.Level(0);
+  const ImageF& max_gradient = keyframe.MaxGradient();
+  const int b = options.border, w = level0.Width(), h = level0.Height();
+  std::vector<Level0Scan> pairs(static_cast<std::size_t>((h + 1) / 2));
+  tbb::parallel_for(0, (h + 1) / 2, [&](int pair) {
+    Level0Scan& scan = pairs[static_cast<std::size_t>(pair)];
+    for (int y = std::max(2 * pair, b); y < std::min(2 * pair + 2, h - b); ++y) {
+      const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
+      for (int x = b; x < w - b; ++x) {
+        const std::size_t i = row + static_cast<std::size_t>(x);
+        const float d = depth.idepth[i], var = depth.variance[i];
+        const bool usable = (depth.valid == nullptr || depth.valid[i] != 0) && d > 0.0f &&
+                            var > 0.0f && std::isfinite(d) && std::isfinite(var) &&
+                            max_gradient(x, y) >= options.min_gradient;
+        if (!usable) continue;
+        if (keep) AddPoint(&scan.points, keyframe.Camera(0), level0, x, y, d, var);
+        if (level1 != nullptr) level1->Add(x, y, d, var);
+        scan.idepth_sum += d;
+        ++scan.count;
+      }
+    }
+  });
+  Level0Scan all;
+  for (const Level0Scan& scan : pairs) {
+    all.idepth_sum += scan.idepth_sum;
+    all.count += scan.count;
+    for (const auto field : kReferenceLevelFields) {
+      (all.points.*field)
+          .insert((all.points.*field).end(), (scan.points.*field).begin(),
+                  (scan.points.*field).end());
+    }
+  }
+  return all;
+}
+
 // Keeps `budget` of the level's points spread evenly over their raster order, so that the
 // kept points sample the map like the full set (selecting the strongest gradients per cell
 // was tried: TUM 6.0 -> 7.9 mm at 5,000 points, docs/benchmarks.md).
@@ -152,50 +200,11 @@ TrackingReference::TrackingReference(std::shared_ptr<const Frame> keyframe,
   if (keyframe_->NumLevels() > 1) {
     level1.emplace(keyframe_->Level(1).Width(), keyframe_->Level(1).Height());
   }
-  // Level 0's points are stored only when a tracker reads them; level 1 is summed from them
-  // as they are found. One task per pair of level-0 rows, which only it maps to: each level-1
-  // pixel gets its contributions in raster order, as from a serial scan.
-  const bool keep_level0 = finest_level_ == 0;
-  const ImageF& max_gradient = keyframe_->MaxGradient();
-  const int b = options.border, w = level0.Width(), h = level0.Height();
-  struct RowPairScan {
-    double idepth_sum = 0.0;
-    std::size_t count = 0;
-    ReferenceLevel points;
-  };
-  std::vector<RowPairScan> scans(static_cast<std::size_t>((h + 1) / 2));
-  tbb::parallel_for(0, (h + 1) / 2, [&](int pair) {
-    RowPairScan& scan = scans[static_cast<std::size_t>(pair)];
-    for (int y = std::max(2 * pair, b); y < std::min(2 * pair + 2, h - b); ++y) {
-      const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
-      for (int x = b; x < w - b; ++x) {
-        const std::size_t i = row + static_cast<std::size_t>(x);
-        const float d = depth.idepth[i], var = depth.variance[i];
-        const bool usable = (depth.valid == nullptr || depth.valid[i] != 0) && d > 0.0f &&
-                            var > 0.0f && std::isfinite(d) && std::isfinite(var) &&
-                            max_gradient(x, y) >= options.min_gradient;
-        if (!usable) continue;
-        if (keep_level0) AddPoint(&scan.points, keyframe_->Camera(0), level0, x, y, d, var);
-        if (level1) level1->Add(x, y, d, var);
-        scan.idepth_sum += d;
-        ++scan.count;
-      }
-    }
-  });
-  ReferenceLevel points;
-  double idepth_sum = 0.0;
-  std::size_t count = 0;
-  for (const RowPairScan& scan : scans) {
-    idepth_sum += scan.idepth_sum;
-    count += scan.count;
-    if (!keep_level0) continue;
-    for (const auto field : kReferenceLevelFields) {
-      (points.*field)
-          .insert((points.*field).end(), (scan.points.*field).begin(), (scan.points.*field).end());
-    }
-  }
-  mean_idepth_ = count ? static_cast<float>(idepth_sum / static_cast<double>(count)) : 0.0f;
-  levels_.push_back(std::move(points));
+  Level0Scan scan =
+      ScanLevel0(*keyframe_, depth, options, finest_level_ == 0, level1 ? &*level1 : nullptr);
+  mean_idepth_ =
+      scan.count ? static_cast<float>(scan.idepth_sum / static_cast<double>(scan.count)) : 0.0f;
+  levels_.push_back(std::move(scan.points));
   if (level1) levels_.push_back(level1->Emit(*keyframe_, 1));
   for (int l = 2; l < keyframe_->NumLevels(); ++l) {
     levels_.push_back(Coarsen(levels_.back(), *keyframe_, l));
