@@ -12,6 +12,39 @@ __m128 Select(__m128 mask, __m128 if_true, __m128 if_false) {
   return _mm_or_ps(_mm_and_ps(mask, if_true), _mm_andnot_ps(mask, if_false));
 }
 
+// The scalar bilinear lookups (intensity and gradient) of the lanes in `mask` at (u, v);
+// returns the mask without the lanes where the frame sees no input (as outside the image).
+unsigned LookUp(const PyramidLevel& frame, __m128 u, __m128 v, unsigned mask, float* intensity,
+                float* gx, float* gy) {
+  alignas(16) float u_lane[4], v_lane[4];
+  _mm_store_ps(u_lane, u);
+  _mm_store_ps(v_lane, v);
+  for (int k = 0; k < 4; ++k) {
+    if ((mask & (1u << k)) == 0) continue;
+    const int x = static_cast<int>(u_lane[k]), y = static_cast<int>(v_lane[k]);
+    if (frame.valid != nullptr && frame.valid[y * frame.Width() + x] == 0) {
+      mask &= ~(1u << k);
+      continue;
+    }
+    intensity[k] = InterpolateBilinear(frame.intensity, u_lane[k], v_lane[k]);
+    gx[k] = InterpolateBilinear(frame.dx, u_lane[k], v_lane[k]);
+    gy[k] = InterpolateBilinear(frame.dy, u_lane[k], v_lane[k]);
+  }
+  return mask;
+}
+
+// HuberWeight per lane: e = |r| / sigma; w = 1 / var, cost = e^2 / 2 inside k; w = k / (e var),
+// cost = k (e - k / 2) beyond.
+void StoreHuber(__m128 residual, __m128 variance, float huber_k, PhotometricBatch* out) {
+  const __m128 k = Splat(huber_k), half = Splat(0.5f), one = Splat(1.0f);
+  const __m128 e = _mm_div_ps(Abs(residual), _mm_sqrt_ps(variance));
+  const __m128 quadratic = _mm_cmple_ps(e, k);
+  _mm_store_ps(out->weight, Select(quadratic, _mm_div_ps(one, variance),
+                                   _mm_div_ps(k, _mm_mul_ps(e, variance))));
+  _mm_store_ps(out->cost, Select(quadratic, _mm_mul_ps(_mm_mul_ps(half, e), e),
+                                 _mm_mul_ps(k, _mm_sub_ps(e, _mm_mul_ps(half, k)))));
+}
+
 }  // namespace
 
 // Every expression below mirrors one of EvaluatePhotometric / HuberWeight, operand order
@@ -40,21 +73,8 @@ void EvaluatePhotometric4(const PyramidLevel& frame, const LevelCamera& camera,
       _mm_and_ps(_mm_cmpge_ps(u, one), _mm_cmpge_ps(v, one)),
       _mm_and_ps(_mm_cmplt_ps(u, Splat(camera.max_u)), _mm_cmplt_ps(v, Splat(camera.max_v))));
   auto mask = static_cast<unsigned>(_mm_movemask_ps(_mm_and_ps(in_front, inside)));
-  alignas(16) float u_lane[4], v_lane[4], intensity[4] = {}, gx[4] = {}, gy[4] = {};
-  _mm_store_ps(u_lane, u);
-  _mm_store_ps(v_lane, v);
-  for (int k = 0; k < 4; ++k) {
-    if ((mask & (1u << k)) == 0) continue;
-    if (frame.valid != nullptr &&
-        frame.valid[static_cast<int>(v_lane[k]) * frame.Width() + static_cast<int>(u_lane[k])] ==
-            0) {
-      mask &= ~(1u << k);  // where the frame sees no input, as outside the image
-      continue;
-    }
-    intensity[k] = InterpolateBilinear(frame.intensity, u_lane[k], v_lane[k]);
-    gx[k] = InterpolateBilinear(frame.dx, u_lane[k], v_lane[k]);
-    gy[k] = InterpolateBilinear(frame.dy, u_lane[k], v_lane[k]);
-  }
+  alignas(16) float intensity[4] = {}, gx[4] = {}, gy[4] = {};
+  mask = LookUp(frame, u, v, mask, intensity, gx, gy);
   out->in_view = mask;
   if (mask == 0) return;
   const __m128 I = _mm_load_ps(intensity), g_x = _mm_load_ps(gx), g_y = _mm_load_ps(gy);
@@ -82,15 +102,7 @@ void EvaluatePhotometric4(const PyramidLevel& frame, const LevelCamera& camera,
   _mm_store_ps(out->residual, residual);
   _mm_store_ps(out->variance, variance);
   _mm_store_ps(out->gradient_sq, _mm_add_ps(_mm_mul_ps(g_x, g_x), _mm_mul_ps(g_y, g_y)));
-  // Huber: e = |r| / sigma; w = 1 / var, cost = e^2 / 2 inside k; w = k / (e var), cost =
-  // k (e - k / 2) beyond.
-  const __m128 k = Splat(model.huber_k), half = Splat(0.5f);
-  const __m128 e = _mm_div_ps(Abs(residual), _mm_sqrt_ps(variance));
-  const __m128 quadratic = _mm_cmple_ps(e, k);
-  _mm_store_ps(out->weight, Select(quadratic, _mm_div_ps(one, variance),
-                                   _mm_div_ps(k, _mm_mul_ps(e, variance))));
-  _mm_store_ps(out->cost, Select(quadratic, _mm_mul_ps(_mm_mul_ps(half, e), e),
-                                 _mm_mul_ps(k, _mm_sub_ps(e, _mm_mul_ps(half, k)))));
+  StoreHuber(residual, variance, model.huber_k, out);
 }
 
 }  // namespace parallax
