@@ -5,11 +5,12 @@
 
 #include <filesystem>
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/core.hpp>
 #include <random>
 
 #include "backend/system.hpp"
 #include "tests/tools/temp_dir.hpp"
+#include "tools/dataset/image_file.hpp"
 #include "tools/run_pipeline.hpp"
 #include "tools/synth/synthetic_sequence.hpp"
 
@@ -28,7 +29,7 @@ std::string WriteSequence(const test::TempDir& dir, const std::string& name, int
     }
     const std::string file = name + "/rgb/" + std::to_string(i) + ".png";
     std::filesystem::create_directories(std::filesystem::path(dir.File(file)).parent_path());
-    cv::imwrite(dir.File(file), m);
+    WritePngFile(dir.File(file), m);
     list += std::to_string(i / 30.0) + " rgb/" + std::to_string(i) + ".png\n";
   }
   dir.Write(name + "/rgb.txt", list);
@@ -86,7 +87,7 @@ TEST(UnusableInput, ADarkStretchInsideARenderIsLostThenTracked) {
     if (line.empty() || line[0] == '#') continue;
     if (index >= 20 && index < 30) {
       const std::string file = line.substr(line.find(' ') + 1);
-      cv::imwrite(dir.File("room/" + file), cv::Mat(480, 640, CV_8UC1, cv::Scalar(0)));
+      WritePngFile(dir.File("room/" + file), cv::Mat(480, 640, CV_8UC1, cv::Scalar(0)));
     }
     ++index;
   }

@@ -1,17 +1,18 @@
 // Dataset layouts' text files: the first byte picks the file (TUM rgb.txt, KITTI times.txt and
 // calib.txt, EuRoC data.csv, monoVO times.txt and camera.txt), the rest is its content; the
 // dataset is then opened and its first frames and ground truth read.
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/core.hpp>
 
 #include "fuzz_input.hpp"
 #include "tools/dataset/dataset_reader.hpp"
+#include "tools/dataset/image_file.hpp"
 
 namespace {
 
 void WritePng(const std::filesystem::path& path) {
   // A valid 16x12 image, so that the list files are what gets exercised.
   std::filesystem::create_directories(path.parent_path());
-  cv::imwrite(path.string(), cv::Mat(12, 16, CV_8UC1, cv::Scalar(90)));
+  parallax::WritePngFile(path.string(), cv::Mat(12, 16, CV_8UC1, cv::Scalar(90)));
 }
 
 }  // namespace

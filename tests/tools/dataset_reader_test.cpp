@@ -5,12 +5,12 @@
 
 #include <gtest/gtest.h>
 
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/videoio.hpp>
+#include <opencv2/core.hpp>
 
 #include "tests/tools/temp_dir.hpp"
 #include "tools/dataset/calibration_yaml.hpp"
 #include "tools/dataset/file_list_reader.hpp"
+#include "tools/dataset/image_file.hpp"
 #include "tools/dataset/input_error.hpp"
 
 namespace parallax {
@@ -21,7 +21,7 @@ using test::TempDir;
 
 void WriteGreyPng(const std::string& path, int w, int h, int value) {
   std::filesystem::create_directories(std::filesystem::path(path).parent_path());
-  cv::imwrite(path, cv::Mat(h, w, CV_8UC1, cv::Scalar(value)));
+  WritePngFile(path, cv::Mat(h, w, CV_8UC1, cv::Scalar(value)));
 }
 
 std::string PinholeYaml(int w, int h, const std::string& extra = "") {
@@ -256,30 +256,6 @@ TEST(ImageFolderReader, NaturalOrderAndFpsTimestamps) {
   EXPECT_DOUBLE_EQ(times[2], 0.2);
   dir.Write("calibration.yaml", PinholeYaml(32, 24));
   EXPECT_THROW(OpenDataset(dir.Path().string()), InputError);  // neither times.txt nor fps
-}
-
-TEST(VideoReader, ReadsFramesWithCalibration) {
-  TempDir dir;
-  const std::string video = dir.File("clip.avi");
-  cv::VideoWriter writer(video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25.0, cv::Size(64, 48),
-                         false);
-  if (!writer.isOpened()) GTEST_SKIP() << "this OpenCV build cannot write MJPG video";
-  for (int i = 0; i < 5; ++i) writer.write(cv::Mat(48, 64, CV_8UC1, cv::Scalar(40 * i)));
-  writer.release();
-  EXPECT_THROW(OpenDataset(video), InputError);  // no calibration yet
-  dir.Write("clip.yaml",
-            "model: pinhole\nwidth: 64\nheight: 48\nfx: 50\nfy: 50\ncx: 31.5\ncy: 23.5\n");
-  const auto reader = OpenDataset(video);
-  EXPECT_EQ(reader->Format(), DatasetFormat::kVideo);
-  int count = 0;
-  double last = -1.0;
-  while (auto f = reader->Next()) {
-    EXPECT_GT(f->timestamp, last);
-    last = f->timestamp;
-    EXPECT_NEAR(f->image(10, 10), 40 * count, 6);
-    ++count;
-  }
-  EXPECT_EQ(count, 5);
 }
 
 }  // namespace

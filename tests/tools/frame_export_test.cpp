@@ -7,12 +7,13 @@
 
 #include <filesystem>
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/core.hpp>
 #include <sstream>
 
 #include "core/undistorter.hpp"
 #include "tests/tools/temp_dir.hpp"
 #include "tools/dataset/dataset_reader.hpp"
+#include "tools/dataset/image_file.hpp"
 #include "tools/synth/synthetic_sequence.hpp"
 
 namespace parallax {
@@ -48,7 +49,7 @@ void ExpectExportMatchesTheEngineInput(const std::string& dataset, const std::st
     EXPECT_NEAR(t, frame->timestamp, 1e-6);
     std::string file = out;
     file += "/images/" + name;
-    const cv::Mat written = cv::imread(file + ".png", cv::IMREAD_UNCHANGED);
+    const cv::Mat written = ReadImageFile(file + ".png", ImageReadMode::kUnchanged);
     const ImageU8 expected = undistorter.Apply(frame->image);
     ASSERT_EQ(written.cols, expected.Width());
     ASSERT_EQ(written.rows, expected.Height());

@@ -5,12 +5,13 @@
 
 #include <filesystem>
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/camera.hpp"
 #include "core/validity_mask.hpp"
 #include "tests/tools/temp_dir.hpp"
+#include "tools/dataset/image_file.hpp"
 #include "tools/dataset/trajectory.hpp"
 #include "tools/eval/evaluation.hpp"
 #include "tools/run_pipeline.hpp"
@@ -38,10 +39,10 @@ void DistortImages(const std::string& folder) {
     }
   }
   for (const auto& entry : std::filesystem::directory_iterator(folder)) {
-    const cv::Mat rendered = cv::imread(entry.path().string(), cv::IMREAD_GRAYSCALE);
+    const cv::Mat rendered = ReadImageFile(entry.path().string(), ImageReadMode::kGrey8);
     cv::Mat distorted;
     cv::remap(rendered, distorted, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
-    ASSERT_TRUE(cv::imwrite(entry.path().string(), distorted));
+    WritePngFile(entry.path().string(), distorted);
   }
 }
 

@@ -10,13 +10,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/core.hpp>
 #include <random>
 #include <set>
 #include <sstream>
 
 #include "tests/tools/temp_dir.hpp"
 #include "tools/dataset/groundtruth_files.hpp"
+#include "tools/dataset/image_file.hpp"
 #include "tools/dataset/trajectory.hpp"
 #include "tools/eval/evaluation.hpp"
 #include "tools/run_pipeline.hpp"
@@ -84,7 +85,7 @@ std::vector<ExposedFrame> WriteExposedCopy(const std::string& clip, const std::s
   const int n = static_cast<int>(images.size());
   for (int k = 0; k < n; ++k) {
     const ClipImage& source = images[static_cast<std::size_t>(k)];
-    cv::Mat image = cv::imread(clip + "/" + source.file, cv::IMREAD_GRAYSCALE);
+    cv::Mat image = ReadImageFile(clip + "/" + source.file, ImageReadMode::kGrey8);
     const double gain = Gain(k, n, dark, bright);
     for (int y = 0; y < image.rows; ++y) {
       for (int x = 0; x < image.cols; ++x) {
@@ -93,7 +94,7 @@ std::vector<ExposedFrame> WriteExposedCopy(const std::string& clip, const std::s
             static_cast<std::uint8_t>(std::clamp(std::lround(v), 0L, 255L));
       }
     }
-    cv::imwrite(out + "/" + source.file, image);
+    WritePngFile(out + "/" + source.file, image);
     exposed.push_back({source.timestamp, gain});
   }
   return exposed;

@@ -4,10 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/core.hpp>
 
 #include "tests/tools/temp_dir.hpp"
 #include "tools/dataset/dataset_reader.hpp"
+#include "tools/dataset/image_file.hpp"
 #include "tools/synth/renderer.hpp"
 #include "tools/synth/synthetic_sequence.hpp"
 
@@ -220,7 +221,7 @@ TEST(SynthSequence, TumReaderAcceptsOutputWithoutFlags) {
   EXPECT_TRUE(std::equal(expected.image.Data(), expected.image.Data() + expected.image.NumPixels(),
                          first->image.Data()));
   EXPECT_TRUE(gt->at(2).T_w_c.Matrix().isApprox(FramePose(options, scene, 2).Matrix(), 1e-8));
-  const cv::Mat depth = cv::imread(out + "/depth/0.000000.png", cv::IMREAD_UNCHANGED);
+  const cv::Mat depth = ReadImageFile(out + "/depth/0.000000.png", ImageReadMode::kUnchanged);
   ASSERT_EQ(depth.type(), CV_16UC1);
   EXPECT_NEAR(depth.at<std::uint16_t>(60, 80) / 5000.0, expected.depth(80, 60), 1e-3);
 }

@@ -4,12 +4,13 @@
 
 #include <filesystem>
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/core.hpp>
 #include <optional>
 
 #include "core/check.hpp"
 #include "core/undistorter.hpp"
 #include "tools/dataset/frame_prefetcher.hpp"
+#include "tools/dataset/image_file.hpp"
 #include "tools/dataset/input_error.hpp"
 #include "tools/dataset/opencv_image.hpp"
 #include "tools/dataset/photometric_corrector.hpp"
@@ -42,9 +43,7 @@ FrameExportSummary ExportFrames(const FrameExportOptions& options) {
     }
     const std::string name = fmt::format("{:06d}", frame->index);
     const std::string file = (out / "images" / (name + ".png")).string();
-    if (!cv::imwrite(file, GreyMatView(frame->image), {cv::IMWRITE_PNG_COMPRESSION, 1})) {
-      throw InputError(file, "cannot write image");
-    }
+    WritePngFile(file, GreyMatView(frame->image), 1);
     times << name << ' ' << fmt::format("{:.6f}", frame->timestamp) << '\n';
     ++summary.frames;
   }

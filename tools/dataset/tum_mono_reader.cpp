@@ -4,10 +4,11 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/core.hpp>
 
 #include "tools/dataset/calibration_yaml.hpp"
 #include "tools/dataset/file_list_reader.hpp"
+#include "tools/dataset/image_file.hpp"
 #include "tools/dataset/input_error.hpp"
 #include "tools/dataset/photometric_corrector.hpp"
 #include "tools/dataset/text_lines.hpp"
@@ -110,8 +111,8 @@ PhotometricCalibration ReadPhotometric(const fs::path& folder, const Camera& cam
   }
   const std::string vignette = (folder / "vignette.png").string();
   if (fs::exists(vignette)) {
-    const cv::Mat v = cv::imread(vignette, cv::IMREAD_UNCHANGED);
-    if (v.empty() || v.channels() != 1) throw InputError(vignette, "unreadable or not grey");
+    const cv::Mat v = ReadImageFile(vignette, ImageReadMode::kUnchanged);
+    if (v.channels() != 1) throw InputError(vignette, "not a grey image");
     if (v.cols != camera.Width() || v.rows != camera.Height()) {
       throw InputError(vignette, "size differs from the camera");
     }

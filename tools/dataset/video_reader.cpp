@@ -1,12 +1,13 @@
-// A video file read with OpenCV, with a calibration YAML (docs/datasets.md).
+// A video file read with OpenCV (through the media module), with a calibration YAML
+// (docs/datasets.md).
 
 #include <filesystem>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 
 #include "tools/dataset/calibration_yaml.hpp"
 #include "tools/dataset/file_list_reader.hpp"
 #include "tools/dataset/input_error.hpp"
+#include "tools/dataset/media_module.hpp"
 #include "tools/dataset/opencv_image.hpp"
 
 namespace fs = std::filesystem;
@@ -18,11 +19,16 @@ class VideoReader final : public DatasetReader {
  public:
   VideoReader(std::string path, CalibrationFile calib)
       : path_(std::move(path)), calib_(std::move(calib)) {
-    if (!capture_.open(path_)) throw InputError(path_, "cannot open video");
-    const double container_fps = capture_.get(cv::CAP_PROP_FPS);
+    try {
+      video_ = LoadMediaModule().OpenVideo(path_);
+    } catch (const std::runtime_error& e) {
+      throw InputError(path_, e.what());
+    }
+    if (!video_) throw InputError(path_, "cannot open video");
+    const double container_fps = video_->ContainerFps();
     fps_ = calib_.fps ? *calib_.fps : container_fps;
     if (!(fps_ > 0.0)) throw InputError(path_, "frame rate unknown: set 'fps' in the calibration");
-    const double count = capture_.get(cv::CAP_PROP_FRAME_COUNT);
+    const double count = video_->ContainerFrameCount();
     num_frames_ = count > 0 ? static_cast<std::size_t>(count) : 0;
   }
 
@@ -32,7 +38,7 @@ class VideoReader final : public DatasetReader {
 
   std::optional<DatasetFrame> Next() override {
     cv::Mat bgr;
-    if (!capture_.read(bgr) || bgr.empty()) return std::nullopt;
+    if (!video_->Read(&bgr)) return std::nullopt;
     cv::Mat grey;
     if (bgr.channels() == 1) {
       grey = bgr;
@@ -46,7 +52,7 @@ class VideoReader final : public DatasetReader {
       throw InputError(frame.source, "frame size differs from the calibration");
     }
     // The container's presentation time when it has one and it increases, else index / fps.
-    const double msec = capture_.get(cv::CAP_PROP_POS_MSEC);
+    const double msec = video_->PositionMs();
     double t = calib_.fps ? static_cast<double>(frame.index) / fps_ : msec * 1e-3;
     if (!(t > last_timestamp_)) t = static_cast<double>(frame.index) / fps_;
     if (!(t > last_timestamp_)) t = last_timestamp_ + 1.0 / fps_;
@@ -59,7 +65,7 @@ class VideoReader final : public DatasetReader {
  private:
   std::string path_;
   CalibrationFile calib_;
-  cv::VideoCapture capture_;
+  std::unique_ptr<VideoSource> video_;
   double fps_ = 0.0;
   std::size_t num_frames_ = 0;
   std::size_t index_ = 0;

@@ -7,11 +7,12 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/core.hpp>
 #include <vector>
 
 #include "core/check.hpp"
 #include "tools/dataset/calibration_yaml.hpp"
+#include "tools/dataset/image_file.hpp"
 #include "tools/dataset/input_error.hpp"
 #include "tools/dataset/opencv_image.hpp"
 #include "tools/dataset/trajectory.hpp"
@@ -44,11 +45,7 @@ void WriteLines(const std::string& path, const std::string& text) {
   if (!out) throw InputError(path, "write failed");
 }
 
-void WritePng(const std::string& path, const cv::Mat& image) {
-  if (!cv::imwrite(path, image, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
-    throw InputError(path, "cannot write image");
-  }
-}
+void WritePng(const std::string& path, const cv::Mat& image) { WritePngFile(path, image, 1); }
 
 }  // namespace
 

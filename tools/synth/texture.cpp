@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/check.hpp"
+#include "tools/dataset/image_file.hpp"
 #include "tools/dataset/input_error.hpp"
 #include "tools/synth/random.hpp"
 
@@ -163,8 +163,7 @@ Texture Texture::Procedural(Material material, int size, std::uint64_t seed) {
 }
 
 Texture Texture::FromFile(const std::string& path) {
-  const cv::Mat grey = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (grey.empty()) throw InputError(path, "unreadable texture image");
+  const cv::Mat grey = ReadImageFile(path, ImageReadMode::kGrey8);
   int size = 8;
   while (size * 2 <= std::min({grey.cols, grey.rows, 1024})) size *= 2;
   cv::Mat resized;
