@@ -47,4 +47,35 @@ void EvaluatePhotometric4(const PyramidLevel& frame, const LevelCamera& camera,
                           const PhotometricModel& model, const PhotometricPoints& points,
                           std::size_t first, PhotometricBatch* out);
 
+/// Calls add(i, dr_dp, p, residual, variance, gradient_sq, RobustWeight) for every point
+/// i in [first, end) that lands inside `frame`, in point order: four at a time through
+/// EvaluatePhotometric4, the remainder through its scalar twin (the same results either way).
+template <typename Add>
+void ForEachPhotometricTerm(const PyramidLevel& frame, const LevelCamera& camera,
+                            const PhotometricModel& model, const PhotometricPoints& points,
+                            std::size_t first, std::size_t end, Add&& add) {
+  std::size_t i = first;
+  PhotometricBatch batch;
+  for (; i + 4 <= end; i += 4) {
+    EvaluatePhotometric4(frame, camera, model, points, i, &batch);
+    for (std::size_t lane = 0; lane < 4; ++lane) {
+      if ((batch.in_view & (1u << lane)) == 0) continue;
+      add(i + lane,
+          Eigen::Vector3f(batch.dr_dp[0][lane], batch.dr_dp[1][lane], batch.dr_dp[2][lane]),
+          Eigen::Vector3f(batch.p[0][lane], batch.p[1][lane], batch.p[2][lane]),
+          batch.residual[lane], batch.variance[lane], batch.gradient_sq[lane],
+          RobustWeight{batch.weight[lane], batch.cost[lane]});
+    }
+  }
+  PhotometricTerm term;
+  for (; i < end; ++i) {
+    if (EvaluatePhotometric(frame, camera, model.M, model.t, points.ray_x[i], points.ray_y[i],
+                            points.idepth[i], points.idepth_variance[i], points.ref_intensity[i],
+                            model.gain, model.offset, model.pixel_noise_variance, &term)) {
+      add(i, term.dr_dp, term.p, term.residual, term.variance, term.gradient_sq,
+          HuberWeight(term.residual, term.variance, model.huber_k));
+    }
+  }
+}
+
 }  // namespace parallax

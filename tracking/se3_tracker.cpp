@@ -24,8 +24,7 @@ struct EvaluatedProblem : LinearizedProblem<8> {
   Se3Tracker::LevelEvaluation evaluation;
 };
 
-// Points [first, end) of a level: four at a time (SSE2), then one by one, with the same
-// results either way (tracking/photometric_batch.hpp), added in point order.
+// Points [first, end) of a level, added in point order (tracking/photometric_batch.hpp).
 void EvaluateBlock(const PyramidLevel& image, const LevelCamera& camera,
                    const PhotometricModel& model, const ReferenceLevel& points, float good_sq,
                    std::size_t first, std::size_t end, Se3Tracker::LevelEvaluation* sum) {
@@ -45,27 +44,7 @@ void EvaluateBlock(const PyramidLevel& image, const LevelCamera& camera,
   };
   const PhotometricPoints soa{points.ray_x.data(), points.ray_y.data(), points.idepth.data(),
                               points.variance.data(), points.intensity.data()};
-  std::size_t i = first;
-  PhotometricBatch batch;
-  for (; i + 4 <= end; i += 4) {
-    EvaluatePhotometric4(image, camera, model, soa, i, &batch);
-    for (std::size_t lane = 0; lane < 4; ++lane) {
-      if ((batch.in_view & (1u << lane)) == 0) continue;
-      add(i + lane, {batch.dr_dp[0][lane], batch.dr_dp[1][lane], batch.dr_dp[2][lane]},
-          {batch.p[0][lane], batch.p[1][lane], batch.p[2][lane]}, batch.residual[lane],
-          batch.variance[lane], batch.gradient_sq[lane],
-          RobustWeight{batch.weight[lane], batch.cost[lane]});
-    }
-  }
-  PhotometricTerm term;
-  for (; i < end; ++i) {
-    if (EvaluatePhotometric(image, camera, model.M, model.t, points.ray_x[i], points.ray_y[i],
-                            points.idepth[i], points.variance[i], points.intensity[i], model.gain,
-                            model.offset, model.pixel_noise_variance, &term)) {
-      add(i, term.dr_dp, term.p, term.residual, term.variance, term.gradient_sq,
-          HuberWeight(term.residual, term.variance, model.huber_k));
-    }
-  }
+  ForEachPhotometricTerm(image, camera, model, soa, first, end, add);
   accumulator.FlushInto(&sum->equations);
 }
 

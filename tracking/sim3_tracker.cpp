@@ -8,6 +8,7 @@
 #include "core/check.hpp"
 #include "core/normal_equations.hpp"
 #include "tracking/levenberg_marquardt.hpp"
+#include "tracking/photometric_batch.hpp"
 #include "tracking/photometric_residual.hpp"
 #include "tracking/tracking_quality.hpp"
 
@@ -62,49 +63,50 @@ Evaluation EvaluateLevel(const Sim3TrackerOptions& options, const ReferenceLevel
   const Eigen::Matrix3f M =
       (state.S_other_ref.Scale() * state.S_other_ref.Rotation().Matrix()).cast<float>();
   const Eigen::Vector3f t = state.S_other_ref.Translation().cast<float>();
-  const float gain = state.affine.Gain(), offset = state.affine.b;
-  const float noise_var = options.pixel_noise_sigma * options.pixel_noise_sigma;
+  const float gain = state.affine.Gain();
+  const PhotometricModel model{M,
+                               t,
+                               gain,
+                               state.affine.b,
+                               options.pixel_noise_sigma * options.pixel_noise_sigma,
+                               options.huber_threshold};
   const float good_sq = options.good_threshold * options.good_threshold;
   Evaluation e;
   BlockAccumulator<kParams> block;
-  PhotometricTerm term;
-  for (std::size_t i = 0; i < points.Size(); ++i) {
-    if (!EvaluatePhotometric(image, camera, M, t, points.ray_x[i], points.ray_y[i],
-                             points.idepth[i], points.variance[i], points.intensity[i], gain,
-                             offset, noise_var, &term)) {
-      continue;
-    }
+  const auto add = [&](std::size_t i, const Eigen::Vector3f& dr_dp, const Eigen::Vector3f& p,
+                       float residual, float variance, float gradient_sq, const RobustWeight& w) {
     // Photometric residual: J = [dr/dp, p x dr/dp, dr/dp . p, -exp(a) I_ref, -1].
     Eigen::Matrix<float, kParams, 1> J;
-    J.head<3>() = term.dr_dp;
-    J.segment<3>(3) = term.p.cross(term.dr_dp);
-    J[6] = term.dr_dp.dot(term.p);
+    J.head<3>() = dr_dp;
+    J.segment<3>(3) = p.cross(dr_dp);
+    J[6] = dr_dp.dot(p);
     J[7] = -gain * points.intensity[i];
     J[8] = -1.0f;
-    const RobustWeight w = HuberWeight(term.residual, term.variance, options.huber_threshold);
-    block.Add(J, term.residual, w.weight, w.cost);
+    block.Add(J, residual, w.weight, w.cost);
     ++e.in_view;
-    e.good += term.residual * term.residual < good_sq * term.variance;
-    e.sum_sq_residual += static_cast<double>(term.residual) * term.residual;
-    e.sum_gradient_sq += term.gradient_sq;
+    e.good += residual * residual < good_sq * variance;
+    e.sum_sq_residual += static_cast<double>(residual) * residual;
+    e.sum_gradient_sq += gradient_sq;
     // Inverse-depth residual against the other keyframe's depth at the nearest pixel.
-    const float z = term.p.z();
-    const int u = static_cast<int>(std::lround(camera.fx * term.p.x() / z + camera.cx));
-    const int v = static_cast<int>(std::lround(camera.fy * term.p.y() / z + camera.cy));
+    const float z = p.z();
+    const int u = static_cast<int>(std::lround(camera.fx * p.x() / z + camera.cx));
+    const int v = static_cast<int>(std::lround(camera.fy * p.y() / z + camera.cy));
     const float other_idepth = depth.idepth(u, v);
-    if (!(other_idepth > 0.0f)) continue;
+    if (!(other_idepth > 0.0f)) return;
     const float r_d = 1.0f / z - other_idepth;
     // d(1/z)/d idepth = (z - t_z) / (z^2 idepth) (LSD-SLAM's Sim3Tracker).
     const float dd = (z - t.z()) / (z * z * points.idepth[i]);
     const float var_d = depth.variance(u, v) + dd * dd * points.variance[i];
     const float inv_z2 = 1.0f / (z * z);
     Eigen::Matrix<float, kParams, 1> J_d;
-    J_d << 0.0f, 0.0f, -inv_z2, -term.p.y() * inv_z2, term.p.x() * inv_z2, 0.0f, -z * inv_z2, 0.0f,
-        0.0f;
+    J_d << 0.0f, 0.0f, -inv_z2, -p.y() * inv_z2, p.x() * inv_z2, 0.0f, -z * inv_z2, 0.0f, 0.0f;
     const RobustWeight wd = HuberWeight(r_d, var_d, options.depth_huber_threshold);
     block.Add(J_d, r_d, options.depth_weight * wd.weight, options.depth_weight * wd.cost);
     ++e.depth_residuals;
-  }
+  };
+  const PhotometricPoints soa{points.ray_x.data(), points.ray_y.data(), points.idepth.data(),
+                              points.variance.data(), points.intensity.data()};
+  ForEachPhotometricTerm(image, camera, model, soa, 0, points.Size(), add);
   block.FlushInto(&e.equations);
   return e;
 }
