@@ -2,11 +2,13 @@
 
 #include <Eigen/LU>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <utility>
 
 #include "core/check.hpp"
 #include "core/normal_equations.hpp"
+#include "core/rounding.hpp"
 #include "tracking/levenberg_marquardt.hpp"
 #include "tracking/photometric_batch.hpp"
 #include "tracking/photometric_residual.hpp"
@@ -56,6 +58,25 @@ struct EvaluatedProblem : LinearizedProblem<kParams> {
   Evaluation evaluation;
 };
 
+// The depth residual's Jacobian is zero but at translation z, rotation x/y and scale
+// (indices 2, 3, 4, 6). BlockAccumulator::Add with the full vector adds w J_a J_b to every
+// entry; the entries left out here would get products with a zero factor, which leave a
+// finite sum unchanged, so the upper triangle and g are the same bit for bit.
+void AddDepthTerm(const Eigen::Vector4f& J_nonzero, float r, float w, float robust_cost,
+                  BlockAccumulator<kParams>* block) {
+  constexpr std::array<int, 4> kIndex = {2, 3, 4, 6};
+  const Eigen::Vector4f w_J = w * J_nonzero;
+  for (int b = 0; b < 4; ++b) {
+    for (int a = 0; a <= b; ++a) {
+      block->H(kIndex[static_cast<std::size_t>(a)], kIndex[static_cast<std::size_t>(b)]) +=
+          w_J[a] * J_nonzero[b];
+    }
+    block->g[kIndex[static_cast<std::size_t>(b)]] += r * w_J[b];
+  }
+  block->cost += robust_cost;
+  ++block->count;
+}
+
 Evaluation EvaluateLevel(const Sim3TrackerOptions& options, const ReferenceLevel& points,
                          const PyramidLevel& image, const PinholeCamera& K, const DepthLevel& depth,
                          const State& state) {
@@ -89,8 +110,8 @@ Evaluation EvaluateLevel(const Sim3TrackerOptions& options, const ReferenceLevel
     e.sum_gradient_sq += gradient_sq;
     // Inverse-depth residual against the other keyframe's depth at the nearest pixel.
     const float z = p.z();
-    const int u = static_cast<int>(std::lround(camera.fx * p.x() / z + camera.cx));
-    const int v = static_cast<int>(std::lround(camera.fy * p.y() / z + camera.cy));
+    const int u = RoundHalfAwayFromZero(camera.fx * p.x() / z + camera.cx);
+    const int v = RoundHalfAwayFromZero(camera.fy * p.y() / z + camera.cy);
     const float other_idepth = depth.idepth(u, v);
     if (!(other_idepth > 0.0f)) return;
     const float r_d = 1.0f / z - other_idepth;
@@ -98,10 +119,10 @@ Evaluation EvaluateLevel(const Sim3TrackerOptions& options, const ReferenceLevel
     const float dd = (z - t.z()) / (z * z * points.idepth[i]);
     const float var_d = depth.variance(u, v) + dd * dd * points.variance[i];
     const float inv_z2 = 1.0f / (z * z);
-    Eigen::Matrix<float, kParams, 1> J_d;
-    J_d << 0.0f, 0.0f, -inv_z2, -p.y() * inv_z2, p.x() * inv_z2, 0.0f, -z * inv_z2, 0.0f, 0.0f;
+    const Eigen::Vector4f J_d(-inv_z2, -p.y() * inv_z2, p.x() * inv_z2, -z * inv_z2);
     const RobustWeight wd = HuberWeight(r_d, var_d, options.depth_huber_threshold);
-    block.Add(J_d, r_d, options.depth_weight * wd.weight, options.depth_weight * wd.cost);
+    AddDepthTerm(J_d, r_d, options.depth_weight * wd.weight, options.depth_weight * wd.cost,
+                 &block);
     ++e.depth_residuals;
   };
   const PhotometricPoints soa{points.ray_x.data(), points.ray_y.data(), points.idepth.data(),
