@@ -1,5 +1,7 @@
 #include "backend/graph_backend.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -30,7 +32,7 @@ GraphBackend::GraphBackend(const GraphBackendOptions& options, const KeyframeBui
 
 GraphBackend::Alignment GraphBackend::Align(const KeyframeGraph& graph, std::int64_t a_id,
                                             std::int64_t b_id, const Sim3d& S_a_b_guess,
-                                            BackendReport* report, bool accept_poor) {
+                                            bool accept_poor) const {
   Alignment out;
   const auto a_ptr =
       Materialize(graph.GetPtr(a_id), build_.camera, build_.pyramid, build_.reference);
@@ -38,7 +40,6 @@ GraphBackend::Alignment GraphBackend::Align(const KeyframeGraph& graph, std::int
       Materialize(graph.GetPtr(b_id), build_.camera, build_.pyramid, build_.reference);
   const Keyframe& a = *a_ptr;
   const Keyframe& b = *b_ptr;
-  report->alignments += 2;
   const auto usable = [&](TrackingStatus status) {
     return status == TrackingStatus::kOk || (accept_poor && status == TrackingStatus::kPoor);
   };
@@ -104,33 +105,58 @@ Matrix7d GraphBackend::FallbackInformation() const {
   return accepted_odometry_[middle->second].second;
 }
 
+std::vector<GraphBackend::AlignmentOutcome> GraphBackend::AlignAll(
+    const KeyframeGraph& graph, std::int64_t b,
+    const std::vector<std::pair<std::int64_t, Sim3d>>& with) const {
+  std::vector<AlignmentOutcome> outcomes(with.size());
+  tbb::parallel_for(std::size_t{0}, with.size(), [&](std::size_t k) {
+    try {
+      outcomes[k].alignment = Align(graph, with[k].first, b, with[k].second);
+    } catch (...) {
+      outcomes[k].error = std::current_exception();
+    }
+  });
+  return outcomes;
+}
+
 BackendReport GraphBackend::KeyframeFinished(KeyframeGraph* graph, std::int64_t id,
                                              std::optional<std::int64_t> parent,
                                              const Sim3d& S_parent_kf) {
   BackendReport report;
-  if (parent && graph->Contains(*parent) && !graph->HasEdge(*parent, id)) {
-    PoseGraphEdge edge;
-    edge.i = *parent;
-    edge.j = id;
-    edge.kind = EdgeKind::kOdometry;
-    const Alignment a = Align(*graph, *parent, id, S_parent_kf, &report);
-    // The chain's measurement is what tracking used; the alignment, when it agrees, says how
-    // well it is known. A failed alignment keeps the chain with a fixed weight.
-    edge.S_i_j = a.accepted && options_.odometry_from_alignment ? a.S_a_b : S_parent_kf;
-    edge.information = a.accepted ? a.information : FallbackInformation();
-    if (a.accepted) accepted_odometry_.emplace_back(a.information.trace(), a.information);
-    graph->AddEdge(edge);
-    ++report.edges_added;
-    report.edges_rejected += a.accepted ? 0 : 1;
-  }
+  // The parent's and the neighbours' alignments are independent (the graph's poses do not
+  // change until the optimisation below): they run together, and their edges are added in
+  // the order aligning one after the other would add them, up to the first that threw.
+  const bool align_parent = parent && graph->Contains(*parent) && !graph->HasEdge(*parent, id);
+  std::vector<std::pair<std::int64_t, Sim3d>> with;
+  if (align_parent) with.emplace_back(*parent, S_parent_kf);
   for (const std::int64_t other : NeighbourCandidates(*graph, id, parent)) {
-    const Sim3d guess = graph->Pose(other).Inverse() * graph->Pose(id);
-    const Alignment a = Align(*graph, other, id, guess, &report);
+    with.emplace_back(other, graph->Pose(other).Inverse() * graph->Pose(id));
+  }
+  const std::vector<AlignmentOutcome> outcomes = AlignAll(*graph, id, with);
+  for (std::size_t k = 0; k < outcomes.size(); ++k) {
+    report.alignments += 2;
+    if (outcomes[k].error) std::rethrow_exception(outcomes[k].error);
+    const Alignment& a = outcomes[k].alignment;
+    if (align_parent && k == 0) {
+      // The chain's measurement is what tracking used; the alignment, when it agrees, says
+      // how well it is known. A failed alignment keeps the chain with a fixed weight.
+      PoseGraphEdge edge;
+      edge.i = *parent;
+      edge.j = id;
+      edge.kind = EdgeKind::kOdometry;
+      edge.S_i_j = a.accepted && options_.odometry_from_alignment ? a.S_a_b : S_parent_kf;
+      edge.information = a.accepted ? a.information : FallbackInformation();
+      if (a.accepted) accepted_odometry_.emplace_back(a.information.trace(), a.information);
+      graph->AddEdge(edge);
+      ++report.edges_added;
+      report.edges_rejected += a.accepted ? 0 : 1;
+      continue;
+    }
     if (!a.accepted) {
       ++report.edges_rejected;
       continue;
     }
-    graph->AddEdge(PoseGraphEdge{other, id, a.S_a_b, a.information, EdgeKind::kNeighbour});
+    graph->AddEdge(PoseGraphEdge{with[k].first, id, a.S_a_b, a.information, EdgeKind::kNeighbour});
     ++report.edges_added;
   }
   if (report.edges_added > 0 && graph->Size() >= 2) {

@@ -4,7 +4,9 @@
 // (docs/architecture.md, "Backend").
 
 #include <cstdint>
+#include <exception>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "backend/keyframe_graph.hpp"
@@ -86,13 +88,24 @@ class GraphBackend {
     double reciprocal_distance = 0.0;         ///< with the scaled information
   };
   /// Aligns keyframes a and b both ways from the guess S_a_b (compacted keyframes are
-  /// rebuilt for it); accepted when both directions converge "ok" (or "poor" too, with
-  /// `accept_poor`) and pass the reciprocal check; a converged pair that fails the check
-  /// is returned with accepted = false (place recognition applies its own gate).
+  /// rebuilt for it): two Sim(3) alignments. Accepted when both directions converge "ok" (or
+  /// "poor" too, with `accept_poor`) and pass the reciprocal check; a converged pair that
+  /// fails the check is returned with accepted = false. Thread-safe (const, no shared state).
   Alignment Align(const KeyframeGraph& graph, std::int64_t a, std::int64_t b,
-                  const Sim3d& S_a_b_guess, BackendReport* report, bool accept_poor = false);
+                  const Sim3d& S_a_b_guess, bool accept_poor = false) const;
 
  private:
+  /// Keyframe `b` aligned with each (a, guess S_a_b) in `with`, concurrently (TBB); each
+  /// alignment runs alone, so the results are those of aligning in turn, bit for bit. An
+  /// alignment that threw holds its exception.
+  struct AlignmentOutcome {
+    Alignment alignment;
+    std::exception_ptr error;
+  };
+  std::vector<AlignmentOutcome> AlignAll(
+      const KeyframeGraph& graph, std::int64_t b,
+      const std::vector<std::pair<std::int64_t, Sim3d>>& with) const;
+
   std::vector<std::int64_t> NeighbourCandidates(const KeyframeGraph& graph, std::int64_t id,
                                                 std::optional<std::int64_t> parent) const;
 

@@ -148,9 +148,8 @@ std::optional<GraphBackend::Alignment> LoopCloser::Verify(const KeyframeGraph& g
                                  std::to_string(matches.size()) + " matches");
     return std::nullopt;
   }
-  BackendReport alignments;
-  const GraphBackend::Alignment a = backend->Align(graph, candidate, id, ransac.S_a_b, &alignments,
-                                                   options_.accept_poor_alignment);
+  const GraphBackend::Alignment a =
+      backend->Align(graph, candidate, id, ransac.S_a_b, options_.accept_poor_alignment);
   if (!a.converged) {
     report->rejections.push_back(name + "direct alignment did not converge both ways");
     return std::nullopt;

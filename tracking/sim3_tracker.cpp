@@ -157,7 +157,7 @@ Sim3Tracker::Sim3Tracker(const Sim3TrackerOptions& options) : options_(options) 
 Sim3TrackingResult Sim3Tracker::Track(const TrackingReference& reference,
                                       const TrackingReference& other,
                                       const Sim3d& S_ref_other_guess,
-                                      const AffineBrightness& affine_guess) {
+                                      const AffineBrightness& affine_guess) const {
   CheckArgument(reference.NumLevels() == other.NumLevels() &&
                     reference.Keyframe().Level(0).Width() == other.Keyframe().Level(0).Width() &&
                     reference.Keyframe().Level(0).Height() == other.Keyframe().Level(0).Height(),

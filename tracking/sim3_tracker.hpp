@@ -56,7 +56,7 @@ class Sim3Tracker {
   /// throws std::invalid_argument if the two keyframes' pyramids differ in size.
   Sim3TrackingResult Track(const TrackingReference& reference, const TrackingReference& other,
                            const Sim3d& S_ref_other_guess,
-                           const AffineBrightness& affine_guess = {});
+                           const AffineBrightness& affine_guess = {}) const;
 
   const Sim3TrackerOptions& Options() const { return options_; }
 
