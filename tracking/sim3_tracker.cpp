@@ -77,6 +77,28 @@ void AddDepthTerm(const Eigen::Vector4f& J_nonzero, float r, float w, float robu
   ++block->count;
 }
 
+/// The inverse-depth residual of point p (in the other keyframe, from reference inverse depth
+/// `idepth` with variance `idepth_variance`) against the other keyframe's depth at the nearest
+/// pixel; t_z is the translation's z. Returns whether the other keyframe has depth there.
+bool AddDepthResidual(const Sim3TrackerOptions& options, const LevelCamera& camera,
+                      const DepthLevel& depth, float t_z, const Eigen::Vector3f& p, float idepth,
+                      float idepth_variance, BlockAccumulator<kParams>* block) {
+  const float z = p.z();
+  const int u = RoundHalfAwayFromZero(camera.fx * p.x() / z + camera.cx);
+  const int v = RoundHalfAwayFromZero(camera.fy * p.y() / z + camera.cy);
+  const float other_idepth = depth.idepth(u, v);
+  if (!(other_idepth > 0.0f)) return false;
+  const float r_d = 1.0f / z - other_idepth;
+  // d(1/z)/d idepth = (z - t_z) / (z^2 idepth) (LSD-SLAM's Sim3Tracker).
+  const float dd = (z - t_z) / (z * z * idepth);
+  const float var_d = depth.variance(u, v) + dd * dd * idepth_variance;
+  const float inv_z2 = 1.0f / (z * z);
+  const Eigen::Vector4f J_d(-inv_z2, -p.y() * inv_z2, p.x() * inv_z2, -z * inv_z2);
+  const RobustWeight wd = HuberWeight(r_d, var_d, options.depth_huber_threshold);
+  AddDepthTerm(J_d, r_d, options.depth_weight * wd.weight, options.depth_weight * wd.cost, block);
+  return true;
+}
+
 Evaluation EvaluateLevel(const Sim3TrackerOptions& options, const ReferenceLevel& points,
                          const PyramidLevel& image, const PinholeCamera& K, const DepthLevel& depth,
                          const State& state) {
@@ -108,28 +130,61 @@ Evaluation EvaluateLevel(const Sim3TrackerOptions& options, const ReferenceLevel
     e.good += residual * residual < good_sq * variance;
     e.sum_sq_residual += static_cast<double>(residual) * residual;
     e.sum_gradient_sq += gradient_sq;
-    // Inverse-depth residual against the other keyframe's depth at the nearest pixel.
-    const float z = p.z();
-    const int u = RoundHalfAwayFromZero(camera.fx * p.x() / z + camera.cx);
-    const int v = RoundHalfAwayFromZero(camera.fy * p.y() / z + camera.cy);
-    const float other_idepth = depth.idepth(u, v);
-    if (!(other_idepth > 0.0f)) return;
-    const float r_d = 1.0f / z - other_idepth;
-    // d(1/z)/d idepth = (z - t_z) / (z^2 idepth) (LSD-SLAM's Sim3Tracker).
-    const float dd = (z - t.z()) / (z * z * points.idepth[i]);
-    const float var_d = depth.variance(u, v) + dd * dd * points.variance[i];
-    const float inv_z2 = 1.0f / (z * z);
-    const Eigen::Vector4f J_d(-inv_z2, -p.y() * inv_z2, p.x() * inv_z2, -z * inv_z2);
-    const RobustWeight wd = HuberWeight(r_d, var_d, options.depth_huber_threshold);
-    AddDepthTerm(J_d, r_d, options.depth_weight * wd.weight, options.depth_weight * wd.cost,
-                 &block);
-    ++e.depth_residuals;
+    e.depth_residuals += AddDepthResidual(options, camera, depth, t.z(), p, points.idepth[i],
+                                          points.variance[i], &block);
   };
   const PhotometricPoints soa{points.ray_x.data(), points.ray_y.data(), points.idepth.data(),
                               points.variance.data(), points.intensity.data()};
   ForEachPhotometricTerm(image, camera, model, soa, 0, points.Size(), add);
   block.FlushInto(&e.equations);
   return e;
+}
+
+EvaluatedProblem Linearize(const Sim3TrackerOptions& options, const ReferenceLevel& points,
+                           const PyramidLevel& image, const PinholeCamera& K,
+                           const DepthLevel& depth, const AffineBrightness& prior, const State& s) {
+  EvaluatedProblem problem;
+  problem.evaluation = EvaluateLevel(options, points, image, K, depth, s);
+  const Evaluation& e = problem.evaluation;
+  problem.residuals = e.in_view;
+  if (e.in_view == 0) return problem;
+  const double n = e.in_view;
+  problem.H = e.equations.SymmetricH() / n;
+  problem.g = e.equations.g / n;
+  problem.cost = e.equations.cost / n;
+  if (options.estimate_affine) {
+    const double da = s.affine.a - prior.a, db = s.affine.b - prior.b;
+    problem.H(7, 7) += options.affine_prior_a;
+    problem.H(8, 8) += options.affine_prior_b;
+    problem.g[7] += options.affine_prior_a * da;
+    problem.g[8] += options.affine_prior_b * db;
+    problem.cost += 0.5 * (options.affine_prior_a * da * da + options.affine_prior_b * db * db);
+  }
+  return problem;
+}
+
+State Retract(const State& s, const Eigen::Matrix<double, kParams, 1>& delta) {
+  State next = s;
+  next.S_other_ref = Sim3d::Exp(delta.head<7>()) * s.S_other_ref;
+  next.affine.a += static_cast<float>(delta[7]);
+  next.affine.b += static_cast<float>(delta[8]);
+  return next;
+}
+
+/// The information of S_ref_other from the finest level's sums (raw, not per point).
+Eigen::Matrix<double, 7, 7> Information(const Sim3TrackerOptions& options, const Evaluation& last,
+                                        const Sim3d& S_ref_other) {
+  // Marginalise the affine parameters: I = H_pp - H_pa H_aa^-1 H_ap.
+  const Eigen::Matrix<double, kParams, kParams> H = last.equations.SymmetricH();
+  Eigen::Matrix<double, 7, 7> info = H.topLeftCorner<7, 7>();
+  if (options.estimate_affine) {
+    const Eigen::Matrix2d H_aa = H.bottomRightCorner<2, 2>();
+    info -= H.topRightCorner<7, 2>() * H_aa.inverse() * H.bottomLeftCorner<2, 7>();
+  }
+  // The Hessian is for left increments of S_other_ref; S_ref_other' = Exp(-Adj(S_ref_other)
+  // delta) S_ref_other, so its information is Adj^-T H Adj^-1.
+  const Eigen::Matrix<double, 7, 7> adj_inv = S_ref_other.Adjoint().inverse();
+  return adj_inv.transpose() * info * adj_inv;
 }
 
 }  // namespace
@@ -177,32 +232,7 @@ Sim3TrackingResult Sim3Tracker::Track(const TrackingReference& reference,
     const PyramidLevel& image = other.Keyframe().Level(level);
     const PinholeCamera& K = other.Keyframe().Camera(level);
     const auto linearize = [&](const State& s) {
-      EvaluatedProblem problem;
-      problem.evaluation = EvaluateLevel(options_, points, image, K, depth, s);
-      const Evaluation& e = problem.evaluation;
-      problem.residuals = e.in_view;
-      if (e.in_view == 0) return problem;
-      const double n = e.in_view;
-      problem.H = e.equations.SymmetricH() / n;
-      problem.g = e.equations.g / n;
-      problem.cost = e.equations.cost / n;
-      if (options_.estimate_affine) {
-        const double da = s.affine.a - prior.a, db = s.affine.b - prior.b;
-        problem.H(7, 7) += options_.affine_prior_a;
-        problem.H(8, 8) += options_.affine_prior_b;
-        problem.g[7] += options_.affine_prior_a * da;
-        problem.g[8] += options_.affine_prior_b * db;
-        problem.cost +=
-            0.5 * (options_.affine_prior_a * da * da + options_.affine_prior_b * db * db);
-      }
-      return problem;
-    };
-    const auto retract = [](const State& s, const Eigen::Matrix<double, kParams, 1>& delta) {
-      State next = s;
-      next.S_other_ref = Sim3d::Exp(delta.head<7>()) * s.S_other_ref;
-      next.affine.a += static_cast<float>(delta[7]);
-      next.affine.b += static_cast<float>(delta[8]);
-      return next;
+      return Linearize(options_, points, image, K, depth, prior, s);
     };
     LmSettings settings;
     settings.max_iterations = MaxIterationsForLevel(options_.max_iterations, level);
@@ -213,7 +243,7 @@ Sim3TrackingResult Sim3Tracker::Track(const TrackingReference& reference,
     EvaluatedProblem final_problem;
     try {
       result.stats.iterations[static_cast<std::size_t>(level)] =
-          MinimizeLevenbergMarquardt<kParams>(&state, linearize, retract, settings, &final_problem);
+          MinimizeLevenbergMarquardt<kParams>(&state, linearize, Retract, settings, &final_problem);
     } catch (const std::invalid_argument&) {
       // A step produced a non-positive or non-finite scale: divergence, reported below.
       result.stats.diverged = true;
@@ -228,19 +258,7 @@ Sim3TrackingResult Sim3Tracker::Track(const TrackingReference& reference,
   const std::size_t total = reference.Level(finest).Size();
   FillPointStatistics({last.in_view, last.good, last.sum_sq_residual, last.sum_gradient_sq}, total,
                       &s);
-  if (last.in_view > 0) {
-    // Marginalise the affine parameters: I = H_pp - H_pa H_aa^-1 H_ap (raw sums, not per point).
-    const Eigen::Matrix<double, kParams, kParams> H = last.equations.SymmetricH();
-    Eigen::Matrix<double, 7, 7> info = H.topLeftCorner<7, 7>();
-    if (options_.estimate_affine) {
-      const Eigen::Matrix2d H_aa = H.bottomRightCorner<2, 2>();
-      info -= H.topRightCorner<7, 2>() * H_aa.inverse() * H.bottomLeftCorner<2, 7>();
-    }
-    // The Hessian is for left increments of S_other_ref; S_ref_other' = Exp(-Adj(S_ref_other)
-    // delta) S_ref_other, so its information is Adj^-T H Adj^-1.
-    const Eigen::Matrix<double, 7, 7> adj_inv = result.S_ref_other.Adjoint().inverse();
-    result.information = adj_inv.transpose() * info * adj_inv;
-  }
+  if (last.in_view > 0) result.information = Information(options_, last, result.S_ref_other);
   if (s.diverged ||
       last.in_view < std::max(20.0, options_.min_usage * static_cast<double>(total))) {
     s.diverged = true;
