@@ -89,31 +89,48 @@ void DepthFilter::UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search
     ++stats->converged_skipped;
     return;
   }
-  StereoObservation obs;
-  if (has_prior) {
-    const float mu = map->idepth[i], sigma = std::sqrt(map->variance[i]);
-    obs = search.Observe(x, y, std::max(options_.min_idepth, mu - 2.0f * sigma),
-                         std::min(options_.max_idepth, mu + 2.0f * sigma), mu,
-                         options_.max_search_length);
+  const StereoObservation obs = ObservePixel(*map, search, x, y, has_prior);
+  if (obs.status != StereoStatus::kOk) {
+    RecordFailure(map, i, has_prior, obs.status, stats);
+  } else if (!has_prior) {
+    CreateEstimate(map, i, obs, stats);
   } else {
-    const float mid = std::sqrt(options_.min_idepth * options_.max_idepth);
-    obs = search.Observe(x, y, options_.min_idepth, options_.max_idepth, mid,
-                         options_.max_search_length_new);
+    FuseObservation(map, x, y, obs, stats);
   }
-  switch (obs.status) {
+}
+
+StereoObservation DepthFilter::ObservePixel(const InverseDepthMap& map,
+                                            const EpipolarSearch& search, int x, int y,
+                                            bool has_prior) const {
+  if (has_prior) {
+    const std::size_t i = map.Index(x, y);
+    const float mu = map.idepth[i], sigma = std::sqrt(map.variance[i]);
+    return search.Observe(x, y, std::max(options_.min_idepth, mu - 2.0f * sigma),
+                          std::min(options_.max_idepth, mu + 2.0f * sigma), mu,
+                          options_.max_search_length);
+  }
+  const float mid = std::sqrt(options_.min_idepth * options_.max_idepth);
+  return search.Observe(x, y, options_.min_idepth, options_.max_idepth, mid,
+                        options_.max_search_length_new);
+}
+
+void DepthFilter::RecordFailure(InverseDepthMap* map, std::size_t i, bool has_prior,
+                                StereoStatus status, DepthUpdateStats* stats) const {
+  switch (status) {
     case StereoStatus::kOk:
-      break;
+      return;
     case StereoStatus::kAmbiguous:
       ++stats->ambiguous;
-      if (!has_prior) --map->blacklist[i];  // LSD-SLAM's rule: two failed creations end the tries
-      if (has_prior) {
-        map->validity[i] -= options_.validity_gain;
-        map->variance[i] *= options_.inconsistency_variance_factor;
-        if (map->variance[i] > options_.max_variance) {
-          Invalidate(map, i);
-          --map->blacklist[i];
-          ++stats->dropped;
-        }
+      if (!has_prior) {
+        --map->blacklist[i];  // LSD-SLAM's rule: two failed creations end the tries
+        return;
+      }
+      map->validity[i] -= options_.validity_gain;
+      map->variance[i] *= options_.inconsistency_variance_factor;
+      if (map->variance[i] > options_.max_variance) {
+        Invalidate(map, i);
+        --map->blacklist[i];
+        ++stats->dropped;
       }
       return;
     case StereoStatus::kNoMatch:
@@ -127,19 +144,25 @@ void DepthFilter::UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search
       ++stats->skipped;
       return;
   }
-  if (!has_prior) {
-    if (!HealthyEstimate(obs.idepth, obs.variance)) {
-      ++stats->diverged;
-      return;
-    }
-    map->idepth[i] = obs.idepth;
-    map->variance[i] = obs.variance;
-    map->validity[i] = options_.initial_validity;
-    map->valid[i] = obs.variance <= options_.max_variance;
-    map->observations[i] = map->valid[i];
-    stats->created += map->valid[i];
+}
+
+void DepthFilter::CreateEstimate(InverseDepthMap* map, std::size_t i, const StereoObservation& obs,
+                                 DepthUpdateStats* stats) const {
+  if (!HealthyEstimate(obs.idepth, obs.variance)) {
+    ++stats->diverged;
     return;
   }
+  map->idepth[i] = obs.idepth;
+  map->variance[i] = obs.variance;
+  map->validity[i] = options_.initial_validity;
+  map->valid[i] = obs.variance <= options_.max_variance;
+  map->observations[i] = map->valid[i];
+  stats->created += map->valid[i];
+}
+
+void DepthFilter::FuseObservation(InverseDepthMap* map, int x, int y, const StereoObservation& obs,
+                                  DepthUpdateStats* stats) const {
+  const std::size_t i = map->Index(x, y);
   // Kalman fusion with a consistency test (chi^2 at one sigma of the combined variance).
   const float prior_var = map->variance[i] * options_.process_noise_factor;
   const float diff = obs.idepth - map->idepth[i];

@@ -79,6 +79,19 @@ class DepthFilter {
  private:
   void UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search, int x, int y,
                    DepthUpdateStats* stats) const;
+  /// The epipolar search of pixel (x, y): within two sigma of its prior when it has one.
+  StereoObservation ObservePixel(const InverseDepthMap& map, const EpipolarSearch& search, int x,
+                                 int y, bool has_prior) const;
+  /// Counts a failed observation of pixel i and applies its consequences (blacklisting,
+  /// a weaker prior).
+  void RecordFailure(InverseDepthMap* map, std::size_t i, bool has_prior, StereoStatus status,
+                     DepthUpdateStats* stats) const;
+  /// A new estimate at pixel i from its first observation.
+  void CreateEstimate(InverseDepthMap* map, std::size_t i, const StereoObservation& obs,
+                      DepthUpdateStats* stats) const;
+  /// Kalman fusion of an observation with pixel (x, y)'s prior, or its rejection.
+  void FuseObservation(InverseDepthMap* map, int x, int y, const StereoObservation& obs,
+                       DepthUpdateStats* stats) const;
   /// Standard deviation below converged_relative_sigma of the inverse depth.
   bool Converged(const InverseDepthMap& map, std::size_t i) const;
   DepthFilterOptions options_;
