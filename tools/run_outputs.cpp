@@ -2,12 +2,12 @@
 
 #include <fmt/format.h>
 
-#include <array>
 #include <bit>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "tools/dataset/input_error.hpp"
 
@@ -52,12 +52,21 @@ std::size_t WritePly(const std::string& path, const System& system) {
       << "\nproperty float x\nproperty float y\nproperty float z\n"
          "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
   static_assert(std::endian::native == std::endian::little, "PLY is written little-endian");
-  std::array<char, 15> record{};
+  // Records are gathered in blocks: a stream write per 15-byte record took 0.3 s for the TUM
+  // clip's 460k points.
+  constexpr std::size_t kRecord = 15, kBlockRecords = 1 << 14;
+  std::vector<char> block(kRecord * kBlockRecords);
+  std::size_t used = 0;
   system.ForEachMapPoint([&](const MapPoint& p) {
-    std::memcpy(record.data(), p.p_w.data(), 12);
-    std::memset(record.data() + 12, p.intensity, 3);
-    out.write(record.data(), record.size());
+    std::memcpy(block.data() + used, p.p_w.data(), 12);
+    std::memset(block.data() + used + 12, p.intensity, 3);
+    used += kRecord;
+    if (used == block.size()) {
+      out.write(block.data(), static_cast<std::streamsize>(used));
+      used = 0;
+    }
   });
+  out.write(block.data(), static_cast<std::streamsize>(used));
   if (!out) throw InputError(path, "write failed");
   return count;
 }
