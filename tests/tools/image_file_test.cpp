@@ -11,7 +11,9 @@
 #include <fstream>
 #include <iterator>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+#include <random>
 #include <vector>
 
 #include "tests/tools/temp_dir.hpp"
@@ -158,6 +160,43 @@ TEST(ImageFile, CorruptTruncatedAndHugeFilesAreRefusedNamingTheFile) {
   const std::string jpeg = dir.File("garbage.jpg");
   WriteBytes(jpeg, std::string("\xff\xd8\xff\xe0", 4) + std::string(200, 'x'));
   ExpectInputErrorNaming(jpeg);
+}
+
+// Fuzzing in miniature (tests/fuzz/fuzz_image does it at length): corrupted PNG and JPEG
+// files either decode to an image of a plausible size or are refused with an InputError.
+TEST(ImageFile, CorruptedBytesAreDecodedOrRefusedNeverCrash) {
+  const TempDir dir;
+  cv::Mat colour = Pattern(CV_8U, 3);
+  cv::GaussianBlur(colour, colour, cv::Size(5, 5), 2.0);
+  const std::string png = dir.File("a.png"), jpeg = dir.File("a.jpg");
+  ASSERT_TRUE(cv::imwrite(png, colour));
+  ASSERT_TRUE(cv::imwrite(jpeg, colour));
+  std::mt19937 rng(11);
+  int decoded = 0, refused = 0;
+  for (const std::string& original : {png, jpeg}) {
+    const std::string bytes = ReadBytes(original);
+    for (int trial = 0; trial < 400; ++trial) {
+      std::string corrupted = bytes;
+      std::uniform_int_distribution<std::size_t> position(2, bytes.size() - 1);
+      for (int k = 0; k < 1 + trial % 8; ++k) {
+        corrupted[position(rng)] = static_cast<char>(rng() & 0xffU);
+      }
+      if (trial % 5 == 0) corrupted.resize(position(rng));
+      const std::string file = dir.File("c" + std::filesystem::path(original).extension().string());
+      WriteBytes(file, corrupted);
+      for (const ImageReadMode mode : {ImageReadMode::kGrey8, ImageReadMode::kUnchanged}) {
+        try {
+          const cv::Mat m = ReadImageFile(file, mode, 1 << 20);
+          EXPECT_LE(static_cast<long long>(m.cols) * m.rows, 1 << 20);
+          ++decoded;
+        } catch (const InputError&) {
+          ++refused;
+        }
+      }
+    }
+  }
+  EXPECT_GT(decoded, 0);
+  EXPECT_GT(refused, 0);
 }
 
 TEST(ImageFile, OtherFormatsGoThroughTheMediaModule) {

@@ -74,11 +74,18 @@ bool ReadHeader(JpegSession* s) {
 }
 
 /// Reads every scanline into `data` (row stride `step`), `channels` 1 (grey) or 3 (BGR).
-bool ReadRows(JpegSession* s, int channels, JSAMPLE* data, std::size_t step) {
+bool ReadRows(JpegSession* s, int channels, JDIMENSION width, JDIMENSION height, JSAMPLE* data,
+              std::size_t step) {
   if (setjmp(s->errors.jump) != 0) return false;
   s->info.out_color_space = channels == 1 ? JCS_GRAYSCALE : JCS_EXT_BGR;
   s->info.out_color_components = channels;
   jpeg_start_decompress(&s->info);
+  // The scanlines must be what the caller allocated (the header's size, `channels`).
+  if (s->info.output_components != channels || s->info.output_width != width ||
+      s->info.output_height != height) {
+    std::snprintf(s->errors.message, sizeof(s->errors.message), "unexpected scanline layout");
+    return false;
+  }
   while (s->info.output_scanline < s->info.output_height) {
     JSAMPROW row = data + static_cast<std::size_t>(s->info.output_scanline) * step;
     jpeg_read_scanlines(&s->info, &row, 1);
@@ -135,7 +142,8 @@ DecodeResult DecodeJpeg(const std::string& path, ImageReadMode mode, long long m
   }
   const int channels = mode == ImageReadMode::kUnchanged && s.info.num_components > 1 ? 3 : 1;
   cv::Mat pixels(static_cast<int>(height), static_cast<int>(width), CV_8UC(channels));
-  if (!ReadRows(&s, channels, pixels.data, pixels.step)) {
+  if (!ReadRows(&s, channels, static_cast<JDIMENSION>(width), static_cast<JDIMENSION>(height),
+                pixels.data, pixels.step)) {
     result.message = std::string("corrupt JPEG: ") + s.errors.message;
     return result;
   }

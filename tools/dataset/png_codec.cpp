@@ -114,6 +114,13 @@ bool ReadRows(PngSession* s, const PngHeader* h, int channels, bool eight_bit, p
   }
   const int passes = png_set_interlace_handling(s->png);
   png_read_update_info(s->png, s->info);
+  // The rows must be what the caller allocated, whatever the file's combination of chunks.
+  const std::size_t sample_bytes = eight_bit ? 1 : 2;
+  if (png_get_rowbytes(s->png, s->info) !=
+      h->width * static_cast<std::size_t>(channels) * sample_bytes) {
+    std::snprintf(s->message, sizeof(s->message), "unexpected row layout");
+    return false;
+  }
   for (int pass = 0; pass < passes; ++pass) {
     for (png_uint_32 y = 0; y < h->height; ++y) png_read_row(s->png, data + y * step, nullptr);
   }
