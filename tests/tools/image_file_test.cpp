@@ -162,6 +162,39 @@ TEST(ImageFile, CorruptTruncatedAndHugeFilesAreRefusedNamingTheFile) {
   ExpectInputErrorNaming(jpeg);
 }
 
+std::string ReadGreyImageError(const std::string& file, int width, int height) {
+  try {
+    (void)ReadGreyImage(file, width, height);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "decoded";
+}
+
+TEST(ReadGreyImage, AFrameOfAnotherSizeIsRefusedSayingBothSizes) {
+  const TempDir dir;
+  const std::string png = dir.File("a.png");
+  ASSERT_TRUE(cv::imwrite(png, Pattern(CV_8U, 1)));  // 53 x 37
+  EXPECT_EQ(ReadGreyImage(png, 53, 37).Width(), 53);
+  // Fewer pixels than the file's: refused from the header; more: decoded, then refused.
+  for (const cv::Size camera : {cv::Size(40, 30), cv::Size(60, 40), cv::Size(37, 53)}) {
+    const std::string error = ReadGreyImageError(png, camera.width, camera.height);
+    EXPECT_NE(error.find(png), std::string::npos) << error;
+    EXPECT_NE(error.find("image is 53x37 but the camera is " + std::to_string(camera.width) +
+                         "x" + std::to_string(camera.height)),
+              std::string::npos)
+        << error;
+  }
+  // A file whose header is right but whose pixels are cut off keeps the decoder's error.
+  const std::string bytes = ReadBytes(png);
+  const std::string truncated = dir.File("truncated.png");
+  WriteBytes(truncated, bytes.substr(0, bytes.size() / 2));
+  const std::string error = ReadGreyImageError(truncated, 53, 37);
+  EXPECT_NE(error.find(truncated), std::string::npos) << error;
+  EXPECT_EQ(error.find("but the camera is"), std::string::npos) << error;
+  EXPECT_NE(error, "decoded");
+}
+
 // Fuzzing in miniature (tests/fuzz/fuzz_image does it at length): corrupted PNG and JPEG
 // files either decode to an image of a plausible size or are refused with an InputError.
 TEST(ImageFile, CorruptedBytesAreDecodedOrRefusedNeverCrash) {

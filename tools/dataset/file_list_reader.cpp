@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <opencv2/core.hpp>
 
 #include "tools/dataset/image_file.hpp"
@@ -21,16 +22,38 @@ void CheckTimestampsIncrease(const std::vector<ImageEntry>& entries) {
   }
 }
 
+namespace {
+
+InputError SizeMismatch(const std::string& path, cv::Size size, cv::Size expected) {
+  return InputError(path, "image is " + std::to_string(size.width) + "x" +
+                              std::to_string(size.height) + " but the camera is " +
+                              std::to_string(expected.width) + "x" +
+                              std::to_string(expected.height));
+}
+
+}  // namespace
+
 ImageU8 ReadGreyImage(const std::string& path, int expected_width, int expected_height) {
-  // The header's size is checked before the pixels are allocated.
-  const cv::Size size = ProbeImageFile(path);
-  if (size.width != expected_width || size.height != expected_height) {
-    throw InputError(path, "image is " + std::to_string(size.width) + "x" +
-                               std::to_string(size.height) + " but the camera is " +
-                               std::to_string(expected_width) + "x" +
-                               std::to_string(expected_height));
+  const cv::Size expected(expected_width, expected_height);
+  cv::Mat grey;
+  try {
+    // Decoded once; an image with more pixels than the camera's is refused from its header,
+    // before its pixels are allocated.
+    grey = ReadImageFile(path, ImageReadMode::kGrey8,
+                         static_cast<long long>(expected_width) * expected_height);
+  } catch (const InputError&) {
+    // Only on failure is the header read again, to say which size the file has.
+    std::optional<cv::Size> size;
+    try {
+      size = ProbeImageFile(path);
+    } catch (const InputError&) {
+      size.reset();  // the header itself is unreadable: the decoder's error stands
+    }
+    if (size && *size != expected) throw SizeMismatch(path, *size, expected);
+    throw;
   }
-  return ReadGreyImage(path);
+  if (grey.size() != expected) throw SizeMismatch(path, grey.size(), expected);
+  return ImageFromGreyMat(grey);
 }
 
 ImageU8 ReadGreyImage(const std::string& path) {
