@@ -180,8 +180,8 @@ TEST(ReadGreyImage, AFrameOfAnotherSizeIsRefusedSayingBothSizes) {
   for (const cv::Size camera : {cv::Size(40, 30), cv::Size(60, 40), cv::Size(37, 53)}) {
     const std::string error = ReadGreyImageError(png, camera.width, camera.height);
     EXPECT_NE(error.find(png), std::string::npos) << error;
-    EXPECT_NE(error.find("image is 53x37 but the camera is " + std::to_string(camera.width) +
-                         "x" + std::to_string(camera.height)),
+    EXPECT_NE(error.find("image is 53x37 but the camera is " + std::to_string(camera.width) + "x" +
+                         std::to_string(camera.height)),
               std::string::npos)
         << error;
   }

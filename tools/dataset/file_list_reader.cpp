@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
-#include <optional>
 #include <opencv2/core.hpp>
+#include <optional>
 
 #include "tools/dataset/image_file.hpp"
 #include "tools/dataset/input_error.hpp"
