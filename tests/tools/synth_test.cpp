@@ -11,9 +11,14 @@
 #include "tools/dataset/image_file.hpp"
 #include "tools/synth/renderer.hpp"
 #include "tools/synth/synthetic_sequence.hpp"
+#include "tools/synth/texture.hpp"
 
 namespace parallax::synth {
 namespace {
+
+// Texture.PostersArePaintedTheSameWithEveryCompiler: g++ 12 before the draws were sequenced.
+constexpr double kPostersSum = 606464.618034;
+constexpr double kPostersWeighted = 5203914.529556;
 
 struct WarpError {
   double median = 0.0;
@@ -109,6 +114,26 @@ TEST(Renderer, DeterministicForASeed) {
   const SynthFrame fc = RenderSynthFrame(options, c, 3);
   EXPECT_FALSE(
       std::equal(fa.image.Data(), fa.image.Data() + fa.image.NumPixels(), fc.image.Data()));
+}
+
+// The posters' shapes take several random draws per shape; drawn inside one call's
+// arguments, their order was the compiler's (g++ and clang painted different posters, and
+// clang's renders failed tracker tests). The texture is now the same with every compiler:
+// these are its values as g++ painted them.
+TEST(Texture, PostersArePaintedTheSameWithEveryCompiler) {
+  const Texture posters = Texture::Procedural(Material::kPosters, 256, 11);
+  double sum = 0.0;
+  double weighted = 0.0;
+  for (int y = 0; y < 64; ++y) {
+    for (int x = 0; x < 64; ++x) {
+      const double value = posters.Sample((static_cast<float>(x) + 0.5F) / 64.0F,
+                                          (static_cast<float>(y) + 0.5F) / 64.0F, 1.0F);
+      sum += value;
+      weighted += value * (x - 31.5) * (y - 31.5);
+    }
+  }
+  EXPECT_NEAR(sum, kPostersSum, 1e-6 * kPostersSum);
+  EXPECT_NEAR(weighted, kPostersWeighted, 1e-3 * std::abs(kPostersWeighted));
 }
 
 TEST(Renderer, PhotometricEffectsAreSwitchable) {

@@ -115,11 +115,20 @@ void PaintShapes(Material material, ImageF* image, std::uint64_t seed) {
   if (material == Material::kPosters) {
     for (int i = 0; i < 90; ++i) {
       const float value = static_cast<float>(rng.Uniform(20.0, 240.0));
+      // One draw per statement: function arguments are evaluated in an unspecified order
+      // (g++ last first, clang first first), and the scene must not depend on the compiler.
+      // Drawn last-first, as g++ drew them for every render measured so far.
       if (rng.Uniform() < 0.6) {
-        PaintRect(image, rng.Uniform(), rng.Uniform(), rng.Uniform(0.02, 0.2),
-                  rng.Uniform(0.02, 0.2), value);
+        const double dv = rng.Uniform(0.02, 0.2);
+        const double du = rng.Uniform(0.02, 0.2);
+        const double v0 = rng.Uniform();
+        const double u0 = rng.Uniform();
+        PaintRect(image, u0, v0, du, dv, value);
       } else {
-        PaintDisc(image, rng.Uniform(), rng.Uniform(), rng.Uniform(0.01, 0.08), value);
+        const double radius = rng.Uniform(0.01, 0.08);
+        const double vc = rng.Uniform();
+        const double uc = rng.Uniform();
+        PaintDisc(image, uc, vc, radius, value);
       }
     }
   } else if (material == Material::kPrint) {
