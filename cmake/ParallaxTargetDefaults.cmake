@@ -1,9 +1,6 @@
 # Compile settings shared by every Parallax target. Applied per target, never through
 # CMAKE_CXX_FLAGS, so that dependencies and consumers are not affected.
-# TEST_CODE marks a test executable: with PARALLAX_SANITIZE_TEST_CODE=OFF its own sources are
-# compiled without the sanitizers (it still links their runtime and the sanitized libraries).
 function(parallax_target_defaults target)
-  cmake_parse_arguments(ARG "TEST_CODE" "" "" ${ARGN})
   target_compile_features(${target} PUBLIC cxx_std_20)
   set_target_properties(${target} PROPERTIES CXX_EXTENSIONS OFF POSITION_INDEPENDENT_CODE ON)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wconversion -Wsign-conversion
@@ -23,12 +20,10 @@ function(parallax_target_defaults target)
     # Coverage feedback from every Parallax library, not only the fuzz targets themselves.
     target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link)
   endif()
-  if(PARALLAX_SANITIZE AND NOT (ARG_TEST_CODE AND NOT PARALLAX_SANITIZE_TEST_CODE))
-    # A finding must fail the test that caused it: UBSan would otherwise report and go on.
-    target_compile_options(${target} PRIVATE -fsanitize=${PARALLAX_SANITIZE}
-                                             -fno-omit-frame-pointer -fno-sanitize-recover=all)
-  endif()
   if(PARALLAX_SANITIZE)
+    # A finding must fail the test that caused it: UBSan would otherwise report and go on.
+    target_compile_options(${target} PUBLIC -fsanitize=${PARALLAX_SANITIZE} -fno-omit-frame-pointer
+                                            -fno-sanitize-recover=all)
     target_link_options(${target} PUBLIC -fsanitize=${PARALLAX_SANITIZE})
   endif()
 endfunction()
