@@ -46,8 +46,7 @@ ImageU8 ReadGreyImage(const std::string& path, int expected_width, int expected_
     std::optional<cv::Size> size;
     try {
       size = ProbeImageFile(path);
-    } catch (const InputError&) {
-      size.reset();  // the header itself is unreadable: the decoder's error stands
+    } catch (const InputError&) {  // the header itself is unreadable: the decoder's error stands
     }
     if (size && *size != expected) throw SizeMismatch(path, *size, expected);
     throw;
