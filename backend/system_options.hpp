@@ -1,0 +1,150 @@
+#pragma once
+// Options of the System (backend/system.hpp): the start, the keyframe rule, each stage's
+// options and the real-time mode (docs/configuration.md).
+
+#include "backend/graph_backend.hpp"
+#include "backend/keyframe_refinement.hpp"
+#include "backend/loop_closer.hpp"
+#include "backend/relocalizer.hpp"
+#include "backend/two_view_bootstrap.hpp"
+#include "backend/update_direction.hpp"
+#include "core/frame_quality.hpp"
+#include "core/image_pyramid.hpp"
+#include "depth/depth_options.hpp"
+#include "tracking/se3_tracker.hpp"
+#include "tracking/tracking_reference.hpp"
+
+namespace parallax {
+
+/// How the first keyframe gets its depth (docs/configuration.md, "Choosing the initialisation").
+enum class Initialization {
+  /// Both at once: random depth tracks from the first frame while a two-view pair is sought;
+  /// the pair either confirms the random start (it is kept) or replaces it.
+  kAuto,
+  kRandom,   ///< LSD-SLAM style random inverse depth refined by the first frames
+  kTwoView,  ///< ORB + essential matrix between the first frame and a later one, then stereo
+};
+
+/// The real-time mode (docs/realtime.md): tracking on the caller's thread against the
+/// published keyframe, depth updates, keyframes and the backend on a mapping thread.
+struct RealtimeOptions {
+  bool enabled = false;
+  /// Tracked frames that may wait for the mapping thread; when more arrive, the oldest
+  /// waiting one is skipped (the newest refines depth best).
+  int max_pending_frames = 1;
+  /// TBB concurrency of tracking (caller's thread) and of the mapping thread: the two-core
+  /// budget is one each, so that neither oversubscribes the other.
+  int tracking_threads = 1;
+  int mapping_threads = 1;
+  /// TBB concurrency of the mapping jobs the caller waits for (the start, frames lost
+  /// live): tracking is idle meanwhile, so they may have both cores. (Under ThreadSanitizer
+  /// every real-time arena is one thread wide: libtbb is not instrumented.)
+  int waited_mapping_threads = 2;
+  /// OpenCV's thread pool (ORB extraction on the mapping thread) is process-wide: a
+  /// real-time System sets it to this when it starts.
+  int opencv_threads = 1;
+  /// A frame past the keyframe rule asks mapping for a new keyframe and tracking goes on
+  /// against the current one; when the rule's distance is exceeded by this factor (or
+  /// usage and consistency fall below the rule's thresholds divided by it) before the new
+  /// keyframe exists, tracking waits for it (unthrottled input would otherwise outrun the
+  /// map: measured 12.9% of path on a 300-frame orbit without the wait).
+  double keyframe_wait_factor = 1.5;
+  /// The snapshot carries the world poses of this many newest finished keyframes, so that
+  /// the live state can follow keyframe changes it did not see (docs/realtime.md).
+  int snapshot_keyframe_poses = 8;
+  /// TBB concurrency of the backend thread, and its niceness (0-19): with two cores it
+  /// shares them with tracking and mapping, which go first when it is positive.
+  int backend_threads = 1;
+  int backend_nice = 10;
+
+  void Check() const;
+};
+
+struct SystemOptions {
+  Initialization initialization = Initialization::kAuto;
+  TwoViewBootstrapOptions bootstrap;
+  /// Give up the two-view search after this many frames without a pair (two_view: then start
+  /// from random depth at that frame; auto: keep the random start).
+  int bootstrap_max_frames = 60;
+  /// Auto: the random start agrees with a two-view pair when the rotations differ by less
+  /// than this and the translation directions by less than `auto_max_direction_deg`.
+  double auto_max_rotation_deg = 2.5;
+  double auto_max_direction_deg = 60.0;
+  /// Auto, when the geometry agrees: the pair's start replaces the random one only if its
+  /// mean residual over the buffered frames is below this fraction of the random start's
+  /// (measured ratios: 0.61-0.71 where the pair is right, 1.04-1.56 where random is).
+  double auto_pair_residual_ratio = 0.9;
+  /// The first keyframe needs at least this share of its pixels with enough gradient for
+  /// depth (a dark or blank first frame is skipped and reported lost).
+  double min_start_texture = 0.01;
+  /// Auto and random: start again from the current frame after this many frames lost in a row
+  /// before initialisation completed.
+  int restart_after_lost = 10;
+  /// ... and at once when a frame's brightness differs from the first keyframe's by more
+  /// than this factor (tracking's gain estimate): the exposure is still settling, as after a
+  /// very dark start, and the start keyframe would soon be beyond tracking's brightness
+  /// range (docs/reliability.md, "Hard input").
+  double max_start_exposure_change = 2.0;
+  /// Frames without usable structure (blank, dark, blown out, noise) are reported lost
+  /// before tracking: they would otherwise be "tracked" into a garbage pose.
+  FrameQualityOptions quality;
+  PyramidOptions pyramid;
+  TrackingReferenceOptions reference;
+  Se3TrackerOptions tracker;
+  DepthFilterOptions depth;
+  /// Translation direction of the depth updates' poses checked against the essential matrix.
+  UpdateDirectionOptions update_direction;
+  /// New keyframe when |t_kf_frame| * mean idepth (distance relative to the mean depth)
+  /// exceeds this, or when fewer than `min_keyframe_usage` of the keyframe points are in view.
+  double keyframe_distance = 0.15;
+  double min_keyframe_usage = 0.6;
+  /// ... or when the share of consistent points falls below this (the view has changed
+  /// enough that the keyframe explains it worse; DSO uses a residual-growth rule alike).
+  double min_keyframe_good_ratio = 0.75;
+  /// No depth update when the baseline relative to the mean depth is below this (static
+  /// camera or pure rotation: no parallax, nothing to learn).
+  double min_update_baseline = 0.004;
+  /// When tracking against the current keyframe is lost, the last `recent_keyframes` finished
+  /// keyframes are tried (from the pose propagated through the similarities, and from the
+  /// keyframe's own pose); the first that tracks "ok" becomes the current keyframe again.
+  int recent_keyframes = 4;
+  /// Frames tracked into a keyframe before it may be replaced.
+  int min_frames_per_keyframe = 3;
+  /// The random start counts as initialised after this many depth updates of the first
+  /// keyframe; the frames tracked before that are then tracked again against the converged
+  /// depth and their poses revised (design.md section 3a). 20 (two thirds of a second at 30
+  /// frames/s; 30 before) makes the start's one-off comparison a third cheaper: 90-frame
+  /// renders 9-13% faster end to end, TUM 5.6 -> 5.9 mm, renders unchanged within noise.
+  int initialization_updates = 20;
+  /// When initialisation completes, the first keyframe's depth and the buffered frames'
+  /// poses are refined jointly (docs/math/keyframe_refinement.md): the depth filter's
+  /// alternation leaves a smooth distortion (a tilt) that joint refinement removes.
+  KeyframeRefinementOptions start_refinement;
+  /// ... on at most this many of the buffered frames (spread, the last included); all are
+  /// then tracked again against the refined depth.
+  int start_refinement_frames = 10;
+  /// At most this many frames are kept for re-tracking before initialisation completes (a
+  /// static start would otherwise keep them all); older ones keep their first pose.
+  int max_buffered_frames = 60;
+  /// ... and at most this many bytes of their pyramids (an 8000x6000 frame's pyramid is
+  /// about 1 GB: a count alone does not bound memory).
+  double max_buffered_megabytes = 512.0;
+  /// Constraint search and pose-graph optimisation when a keyframe is finished; false keeps
+  /// the tracking chain as it is (odometry edges only, never optimised).
+  bool optimize_graph = true;
+  GraphBackendOptions backend;
+  /// Place recognition and loop closure on finished keyframes (needs optimize_graph).
+  LoopClosureOptions loop_closure;
+  /// A frame lost against the current and recent keyframes is relocalised on the keyframe
+  /// database (place recognition data is kept for it even without loop closure).
+  RelocalizationOptions relocalization;
+  /// Recovery from long loss: once no frame has had a pose for this long (input time,
+  /// seconds) and relocalisation keeps failing, a new map is started at the next frame that
+  /// can start one; a later loop to an earlier map merges the two.
+  double new_map_after_lost_s = 2.0;
+  RealtimeOptions realtime;
+
+  void Check() const;
+};
+
+}  // namespace parallax
