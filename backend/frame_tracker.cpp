@@ -4,7 +4,8 @@
 
 namespace parallax {
 
-FrameTracker::FrameTracker(const Se3TrackerOptions& options) : tracker_(options) {}
+FrameTracker::FrameTracker(const Se3TrackerOptions& options)
+    : tracker_(options), velocity_rescale_ratio_(options.velocity_rescale_ratio) {}
 
 TrackingResult DivergedTracking(const std::exception& divergence) {
   TrackingResult result;  // lost
@@ -13,10 +14,24 @@ TrackingResult DivergedTracking(const std::exception& divergence) {
   return result;
 }
 
+SE3d FrameTracker::VelocityFor(double timestamp) const {
+  const double gap = timestamp - state_.last_timestamp;
+  if (!(gap > 0.0) || !(state_.velocity_interval > 0.0)) return state_.T_prev_last;
+  const double ratio = gap / state_.velocity_interval;
+  if (ratio <= velocity_rescale_ratio_ && ratio * velocity_rescale_ratio_ >= 1.0) {
+    return state_.T_prev_last;  // frame-rate jitter: the velocity as measured
+  }
+  return SE3d::Exp(ratio * state_.T_prev_last.Log());
+}
+
 TrackingResult FrameTracker::Track(const TrackingReference& reference, const Frame& frame) {
   TrackingResult tracked = tracker_.Track(
-      reference, frame, MotionHypotheses(state_.T_kf_last, state_.T_prev_last), state_.affine);
+      reference, frame, MotionHypotheses(state_.T_kf_last, VelocityFor(frame.Timestamp())),
+      state_.affine);
   if (tracked.status == TrackingStatus::kLost) return tracked;
+  const double gap = frame.Timestamp() - state_.last_timestamp;
+  state_.velocity_interval = gap > 0.0 ? gap : 0.0;
+  state_.last_timestamp = frame.Timestamp();
   state_.T_prev_last = state_.T_kf_last.Inverse() * tracked.T_kf_frame;
   state_.T_kf_last = tracked.T_kf_frame;
   state_.affine = tracked.affine;
@@ -42,7 +57,7 @@ std::optional<std::pair<std::size_t, TrackingResult>> FrameTracker::Recover(
       r = tracker_.Track(*c.reference, frame, {SE3d()}, AffineBrightness{});
     }
     if (r.status != TrackingStatus::kOk) continue;
-    state_ = MotionState{r.T_kf_frame, SE3d(), r.affine, 1};
+    state_ = MotionState{r.T_kf_frame, SE3d(), r.affine, 1, frame.Timestamp(), 0.0};
     return std::make_pair(k, std::move(r));
   }
   return std::nullopt;
@@ -50,7 +65,7 @@ std::optional<std::pair<std::size_t, TrackingResult>> FrameTracker::Recover(
 
 void FrameTracker::StartKeyframe() {
   // The brightness estimate carries over: the same camera sees the same scene.
-  state_ = MotionState{SE3d(), SE3d(), state_.affine, 0};
+  state_ = MotionState{SE3d(), SE3d(), state_.affine, 0, state_.last_timestamp, 0.0};
 }
 
 }  // namespace parallax

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <exception>
+#include <limits>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -22,6 +23,10 @@ struct MotionState {
   SE3d T_prev_last;  ///< last inter-frame motion (for the constant-velocity guess)
   AffineBrightness affine;
   int frames_in_keyframe = 0;
+  /// Input time of the last tracked frame (seconds; NaN: unknown) and the time T_prev_last
+  /// spans (0: unknown), so that the guess can follow the time a gap of frames took.
+  double last_timestamp = std::numeric_limits<double>::quiet_NaN();
+  double velocity_interval = 0.0;
 };
 
 /// A keyframe to try when tracking is lost on the current one.
@@ -39,7 +44,8 @@ class FrameTracker {
   explicit FrameTracker(const Se3TrackerOptions& options);
 
   /// Tracks `frame` on `reference` from the motion hypotheses; a frame that is not lost
-  /// advances the motion state (a lost one keeps the last good state).
+  /// advances the motion state (a lost one keeps the last good state). The velocity is
+  /// rescaled to the frame's time gap beyond `velocity_rescale_ratio` (Se3TrackerOptions).
   TrackingResult Track(const TrackingReference& reference, const Frame& frame);
   /// One start, no state change (frames tracked again during initialisation).
   TrackingResult TrackFrom(const TrackingReference& reference, const Frame& frame,
@@ -56,7 +62,11 @@ class FrameTracker {
   void SetState(const MotionState& state) { state_ = state; }
 
  private:
+  /// The constant velocity over the time since the last tracked frame.
+  SE3d VelocityFor(double timestamp) const;
+
   Se3Tracker tracker_;
+  double velocity_rescale_ratio_;
   MotionState state_;
 };
 

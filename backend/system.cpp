@@ -336,13 +336,14 @@ void System::SwitchKeyframe(const std::shared_ptr<const Frame>& frame, const Ima
   // Normalising multiplies idepth by s, so a point's new-keyframe coordinates become
   // p' = p / s; the keyframe-to-world similarity absorbs it: S_w_new = S_w_c * Sim3(s).
   const Sim3d S_w_c = CurrentKeyframePose() * Sim3d(tracked.T_kf_frame);
-  const SE3d& last_motion = tracker_.State().T_prev_last;
-  const SE3d velocity(last_motion.Rotation(), last_motion.Translation() / s);
+  const MotionState last = tracker_.State();
+  const SE3d velocity(last.T_prev_last.Rotation(), last.T_prev_last.Translation() / s);
   StartKeyframe(frame, S_w_c * Sim3d(s, SO3d(), Eigen::Vector3d::Zero()), std::move(next), result);
   SetPose(result, SE3d());  // the frame is the new keyframe
   mapper_.Direction().SetKeyframe(frame->Id(), image);
   // Constant-velocity guess for the next frame in the new keyframe's units.
-  tracker_.SetState(MotionState{SE3d(), velocity, AffineBrightness{}, 0});
+  tracker_.SetState(MotionState{SE3d(), velocity, AffineBrightness{}, 0, last.last_timestamp,
+                                last.velocity_interval});
   result->is_keyframe = true;
 }
 

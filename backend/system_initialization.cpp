@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <utility>
 
 #include "backend/system.hpp"
 #include "core/angles.hpp"
@@ -291,6 +293,7 @@ std::vector<RevisedPose> System::StartFromPair(const std::shared_ptr<const Frame
   initial_frames_.clear();
   SE3d guess, previous;
   AffineBrightness affine;
+  double last_time = std::numeric_limits<double>::quiet_NaN(), previous_time = last_time;
   for (const auto& [frame, unused] : buffered) {
     if (frame == pair_frame) guess = T_kf_pair_frame;
     const TrackingResult r = tracker_.TrackFrom(*mapper_.Reference(), *frame, guess, affine);
@@ -298,14 +301,17 @@ std::vector<RevisedPose> System::StartFromPair(const std::shared_ptr<const Frame
     if (r.status != TrackingStatus::kLost) {
       previous = guess;
       guess = r.T_kf_frame;
+      previous_time = std::exchange(last_time, frame->Timestamp());
       affine = r.affine;
       pose = r.T_kf_frame;
     }
     initial_frames_.emplace_back(frame, guess);
     revised.push_back(Revised(*frame, pose));
   }
-  tracker_.SetState(
-      MotionState{guess, previous.Inverse() * guess, affine, static_cast<int>(buffered.size())});
+  const double interval = last_time - previous_time;  // NaN unless two frames were tracked
+  tracker_.SetState(MotionState{guess, previous.Inverse() * guess, affine,
+                                static_cast<int>(buffered.size()), last_time,
+                                interval > 0.0 ? interval : 0.0});
   return revised;
 }
 

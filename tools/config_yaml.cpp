@@ -40,6 +40,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"good_threshold", Set(&o->tracker.good_threshold)},
         {"suspect_good_ratio", Set(&o->tracker.suspect_good_ratio)},
         {"search_rotations_deg", Set(&o->tracker.search_rotations_deg)},
+        {"velocity_rescale_ratio", Set(&o->tracker.velocity_rescale_ratio)},
         {"min_good_ratio_ok", Set(&o->tracker.min_good_ratio_ok)},
         {"min_good_ratio_poor", Set(&o->tracker.min_good_ratio_poor)}}},
       {"depth",

@@ -88,6 +88,8 @@ void Se3TrackerOptions::Check() const {
     CheckOption(std::isfinite(angle) && angle > 0.0 && angle < 90.0, s, "search_rotations_deg",
                 "must be in (0, 90)");
   }
+  CheckOption(velocity_rescale_ratio > 1.0 && std::isfinite(velocity_rescale_ratio), s,
+              "velocity_rescale_ratio", "must be finite and > 1");
 }
 
 Se3Tracker::Se3Tracker(const Se3TrackerOptions& options) : options_(options) { options_.Check(); }

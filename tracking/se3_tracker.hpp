@@ -57,6 +57,12 @@ struct Se3TrackerOptions {
   /// U-turns); the default keeps the earlier 0.03 rad alone (docs/math/tracking.md, "Wide
   /// search rotations").
   std::vector<double> search_rotations_deg = {0.03 * kRadToDeg};
+  /// The constant-velocity guess (backend/frame_tracker.hpp) is rescaled to the time since
+  /// the last tracked frame when that differs from the time the velocity was measured over by
+  /// more than this factor either way: frames dropped at a camera's rate (docs/realtime.md),
+  /// skipped or lost. Within it (frame-rate jitter; TUM's 32/36 ms) the velocity is used as it
+  /// is. Must be > 1.
+  double velocity_rescale_ratio = 1.5;
 
   void Check() const;
 };
