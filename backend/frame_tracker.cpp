@@ -14,8 +14,7 @@ TrackingResult DivergedTracking(const std::exception& divergence) {
   return result;
 }
 
-SE3d FrameTracker::VelocityFor(double timestamp) const {
-  const double gap = timestamp - state_.last_timestamp;
+SE3d FrameTracker::VelocityOver(double gap) const {
   if (!(gap > 0.0) || !(state_.velocity_interval > 0.0)) return state_.T_prev_last;
   const double ratio = gap / state_.velocity_interval;
   if (ratio <= velocity_rescale_ratio_ && ratio * velocity_rescale_ratio_ >= 1.0) {
@@ -25,11 +24,10 @@ SE3d FrameTracker::VelocityFor(double timestamp) const {
 }
 
 TrackingResult FrameTracker::Track(const TrackingReference& reference, const Frame& frame) {
+  const double gap = frame.Timestamp() - state_.last_timestamp;  // NaN after no frame
   TrackingResult tracked = tracker_.Track(
-      reference, frame, MotionHypotheses(state_.T_kf_last, VelocityFor(frame.Timestamp())),
-      state_.affine);
+      reference, frame, MotionHypotheses(state_.T_kf_last, VelocityOver(gap)), state_.affine);
   if (tracked.status == TrackingStatus::kLost) return tracked;
-  const double gap = frame.Timestamp() - state_.last_timestamp;
   state_.velocity_interval = gap > 0.0 ? gap : 0.0;
   state_.last_timestamp = frame.Timestamp();
   state_.T_prev_last = state_.T_kf_last.Inverse() * tracked.T_kf_frame;

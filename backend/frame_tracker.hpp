@@ -62,8 +62,8 @@ class FrameTracker {
   void SetState(const MotionState& state) { state_ = state; }
 
  private:
-  /// The constant velocity over the time since the last tracked frame.
-  SE3d VelocityFor(double timestamp) const;
+  /// The constant velocity over `gap` seconds since the last tracked frame.
+  SE3d VelocityOver(double gap) const;
 
   Se3Tracker tracker_;
   double velocity_rescale_ratio_;
