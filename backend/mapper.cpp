@@ -73,6 +73,7 @@ std::shared_ptr<Keyframe> Mapper::Freeze() const {
 }
 
 void Mapper::Retire() {
+  if (map_) map_->scratch.Release();  // no longer updated (a return to it allocates again)
   if (recent_keyframes_ > 0) {
     recent_.push_front({std::move(map_), std::move(reference_)});
     if (static_cast<int>(recent_.size()) > recent_keyframes_) recent_.pop_back();

@@ -22,26 +22,27 @@ void Invalidate(InverseDepthMap* map, std::size_t i) {
 constexpr std::size_t Idx(int i) { return static_cast<std::size_t>(i); }
 
 /// In place: each pixel becomes the sum of the 5x5 window around it (pixels within 2 of the
-/// border, whose window leaves the image, become 0; callers skip them).
+/// border, whose window leaves the image, become 0; callers skip them). Rows in parallel.
 void BoxSum5x5(int w, int h, std::vector<float>* image) {
   std::vector<float>& v = *image;
   std::vector<float> rows(v.size(), 0.0f);
   const auto at = [w](int x, int y) { return static_cast<std::size_t>(y) * Idx(w) + Idx(x); };
-  for (int y = 0; y < h; ++y) {
+  tbb::parallel_for(0, h, [&](int y) {
     for (int x = 2; x < w - 2; ++x) {
       const std::size_t i = at(x, y);
       rows[i] = v[i - 2] + v[i - 1] + v[i] + v[i + 1] + v[i + 2];
     }
-  }
-  std::fill(v.begin(), v.end(), 0.0f);
+  });
   const std::size_t stride = Idx(w);
-  for (int y = 2; y < h - 2; ++y) {
-    for (int x = 2; x < w - 2; ++x) {
+  tbb::parallel_for(0, h, [&](int y) {
+    const bool inside = y >= 2 && y < h - 2;
+    for (int x = 0; x < w; ++x) {
       const std::size_t i = at(x, y);
-      v[i] = rows[i - 2 * stride] + rows[i - stride] + rows[i] + rows[i + stride] +
-             rows[i + 2 * stride];
+      v[i] = inside && x >= 2 && x < w - 2 ? rows[i - 2 * stride] + rows[i - stride] + rows[i] +
+                                                 rows[i + stride] + rows[i + 2 * stride]
+                                           : 0.0f;
     }
-  }
+  });
 }
 
 void Add(DepthUpdateStats* total, const DepthUpdateStats& s) {
@@ -211,19 +212,25 @@ DepthUpdateStats DepthFilter::Update(InverseDepthMap* map, const StereoFrame& fr
 
 int DepthFilter::Regularize(InverseDepthMap* map) const {
   const int w = map->Width(), h = map->Height();
+  const std::size_t n = map->valid.size();
   // The kernel's inputs once per pixel (0 for invalid ones), and the distance decay as a
-  // table: the 5x5 window is then multiplications and masks only.
-  RegularizeInputs in;
+  // table: the 5x5 window is then multiplications and masks only. The buffers are the map's,
+  // reused: every pixel is written below.
+  RegularizeInputs& in = map->scratch.regularize;
   in.width = w;
   in.idepth = map->idepth.data();
   in.variance = map->variance.data();
-  in.inv_var.assign(map->valid.size(), 0.0f);
-  in.support.assign(map->valid.size(), 0.0f);
-  in.vote.assign(map->valid.size(), 0.0f);
+  in.inv_var.resize(n);
+  in.support.resize(n);
+  in.vote.resize(n);
+  std::vector<std::uint8_t>& keep = map->scratch.keep;
+  keep.resize(n);
   // Per pixel, so rows run in parallel; the count is summed in row order.
   std::vector<int> diverged_in_row(Idx(h), 0);
   tbb::parallel_for(0, h, [&](int y) {
     for (std::size_t i = map->Index(0, y), end = i + Idx(w); i < end; ++i) {
+      in.inv_var[i] = in.support[i] = in.vote[i] = 0.0f;
+      keep[i] = 0;
       if (!map->valid[i]) continue;
       if (!HealthyEstimate(map->idepth[i], map->variance[i])) {
         Invalidate(map, i);
@@ -236,7 +243,7 @@ int DepthFilter::Regularize(InverseDepthMap* map) const {
     }
   });
   int diverged = 0;
-  for (const int n : diverged_in_row) diverged += n;
+  for (const int count : diverged_in_row) diverged += count;
   // Inverse variance, decaying mildly with distance (scale-free form of LSD's
   // 1 / (var + dist^2 * REG_DIST_VAR)).
   for (int dy = -2; dy <= 2; ++dy) {
@@ -244,7 +251,6 @@ int DepthFilter::Regularize(InverseDepthMap* map) const {
       in.decay[Idx((dy + 2) * 5 + dx + 2)] =
           1.0f / (1.0f + 0.1f * static_cast<float>(dx * dx + dy * dy));
   }
-  std::vector<std::uint8_t> keep(map->valid.size(), 0);
   // Valid pixels are eligible ones, which keep a 3-pixel border: the 5x5 window needs no
   // bounds checks.
   tbb::parallel_for(2, h - 2, [&](int y) {
@@ -276,17 +282,19 @@ int DepthFilter::FillHoles(InverseDepthMap* map) const {
   // depth / variance: box filters of the masked maps (separable, a few additions per pixel
   // instead of 25 neighbour visits for each of the ~200k empty eligible pixels).
   std::vector<float> support(n, 0.0f), sum_w(n, 0.0f), sum_wd(n, 0.0f);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!map->valid[i]) continue;
-    support[i] = map->validity[i];
-    sum_w[i] = 1.0f / map->variance[i];
-    sum_wd[i] = map->idepth[i] * sum_w[i];
-  }
+  tbb::parallel_for(0, h, [&](int y) {
+    for (std::size_t i = map->Index(0, y), end = i + Idx(w); i < end; ++i) {
+      if (!map->valid[i]) continue;
+      support[i] = map->validity[i];
+      sum_w[i] = 1.0f / map->variance[i];
+      sum_wd[i] = map->idepth[i] * sum_w[i];
+    }
+  });
   for (std::vector<float>* image : {&support, &sum_w, &sum_wd}) BoxSum5x5(w, h, image);
   // The window sums were taken before any filling, so filling a pixel here changes no other
-  // pixel's decision.
-  int filled = 0;
-  for (int y = 2; y < h - 2; ++y) {
+  // pixel's decision: rows in parallel, counted in row order.
+  std::vector<int> filled_in_row(Idx(h), 0);
+  tbb::parallel_for(2, h - 2, [&](int y) {
     for (int x = 2; x < w - 2; ++x) {
       const std::size_t i = map->Index(x, y);
       if (map->valid[i] || !map->eligible[i]) continue;
@@ -298,9 +306,11 @@ int DepthFilter::FillHoles(InverseDepthMap* map) const {
       map->validity[i] = options_.initial_validity;
       map->observations[i] = 0;
       map->valid[i] = 1;
-      ++filled;
+      ++filled_in_row[Idx(y)];
     }
-  }
+  });
+  int filled = 0;
+  for (const int count : filled_in_row) filled += count;
   return filled;
 }
 

@@ -8,8 +8,27 @@
 #include "core/frame.hpp"
 #include "core/image.hpp"
 #include "depth/depth_options.hpp"
+#include "depth/regularize_kernel.hpp"
 
 namespace parallax {
+
+/// Working memory of the filter's passes over a map (DepthFilter::Regularize), kept with the
+/// map so that a stereo update allocates nothing. Not map state: a copy starts empty, and
+/// Release() returns the memory of a map that is no longer updated.
+class MapScratch {
+ public:
+  MapScratch() = default;
+  ~MapScratch() = default;
+  MapScratch(const MapScratch& /*other*/) {}
+  MapScratch& operator=(const MapScratch& /*other*/) { return *this; }
+  MapScratch(MapScratch&&) noexcept = default;
+  MapScratch& operator=(MapScratch&&) noexcept = default;
+
+  void Release() { *this = MapScratch{}; }
+
+  RegularizeInputs regularize;     ///< the kernel's per-pixel inputs
+  std::vector<std::uint8_t> keep;  ///< the regularisation's verdict per pixel
+};
 
 /// Per-pixel state of the inverse-depth filter (index = y * width + x). A pixel has an
 /// estimate when valid[i] != 0; its raw idepth/variance are filtered by Kalman fusion and
@@ -61,6 +80,8 @@ class InverseDepthMap {
   /// Stereo updates made on this map (DepthFilter::Update): picks which converged estimates
   /// an update re-observes (DepthFilterOptions::converged_recheck).
   std::uint32_t updates = 0;
+  /// The filter's working memory (see MapScratch); empty in a copy.
+  MapScratch scratch;
 
   /// Valid with at least one stereo observation (or from a prior).
   bool IsConfirmed(std::size_t i) const { return valid[i] && observations[i] > 0; }

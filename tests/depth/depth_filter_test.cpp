@@ -4,8 +4,10 @@
 #include "depth/depth_filter.hpp"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <cstring>
 
 #include "tests/tracking/render_fixture.hpp"
 
@@ -263,6 +265,42 @@ TEST_F(DepthFilterTest, PropagationKeepsVisiblePoints) {
   const ErrorSummary s = Summarize(propagated, next.idepth);
   EXPECT_LT(s.median_relative, 0.01);
   EXPECT_LT(s.over_10_percent, 0.02);
+}
+
+// Every per-pixel array, bit for bit.
+bool SameMap(const InverseDepthMap& a, const InverseDepthMap& b) {
+  const auto same = [](const auto& u, const auto& v) {
+    return u.size() == v.size() && std::memcmp(u.data(), v.data(), u.size() * sizeof(u[0])) == 0;
+  };
+  return same(a.idepth, b.idepth) && same(a.variance, b.variance) &&
+         same(a.idepth_smoothed, b.idepth_smoothed) &&
+         same(a.variance_smoothed, b.variance_smoothed) && same(a.validity, b.validity) &&
+         same(a.blacklist, b.blacklist) && same(a.valid, b.valid) &&
+         same(a.observations, b.observations) && a.updates == b.updates;
+}
+
+TEST_F(DepthFilterTest, UpdatesAndPropagationAreTheSameForAnyThreadCount) {
+  // Rows run in parallel and a map reuses its working memory from one update to the next:
+  // neither may change a bit. Five updates from a random start (creations, fusions,
+  // removals), then a propagation (collisions resolved in pixel order) and hole filling.
+  const auto run = [&](int threads) {
+    tbb::task_arena arena(threads);
+    std::unique_ptr<InverseDepthMap> propagated;
+    arena.execute([&] {
+      const DepthFilter filter;
+      InverseDepthMap map(keyframe_->frame, filter.Options());
+      map.InitializeRandom(1.0f);
+      for (int i = 1; i <= 5; ++i) filter.Update(&map, Stereo(i));
+      const InverseDepthMap copy = map;  // a copy starts without working memory
+      EXPECT_TRUE(SameMap(copy, map));
+      propagated = std::make_unique<InverseDepthMap>(
+          filter.Propagate(map, frames_[9], Pose(10).Inverse() * T_w_kf_));
+    });
+    return propagated;
+  };
+  const auto one = run(1), two = run(2);
+  EXPECT_GT(one->NumValid(), 10000u);
+  EXPECT_TRUE(SameMap(*one, *two));
 }
 
 TEST_F(DepthFilterTest, PropagationTransportsVarianceWithDepthChange) {
