@@ -1,10 +1,13 @@
 #include "tracking/sim3_tracker.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <Eigen/LU>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <utility>
+#include <vector>
 
 #include "core/check.hpp"
 #include "core/normal_equations.hpp"
@@ -17,7 +20,8 @@
 namespace parallax {
 namespace {
 
-constexpr int kParams = 9;  // 7 Sim(3) + 2 affine
+constexpr int kParams = 9;                // 7 Sim(3) + 2 affine
+constexpr std::size_t kBlockSize = 2048;  // points per deterministic partial sum
 
 struct State {
   Sim3d S_other_ref;
@@ -99,22 +103,12 @@ bool AddDepthResidual(const Sim3TrackerOptions& options, const LevelCamera& came
   return true;
 }
 
-Evaluation EvaluateLevel(const Sim3TrackerOptions& options, const ReferenceLevel& points,
-                         const PyramidLevel& image, const PinholeCamera& K, const DepthLevel& depth,
-                         const State& state) {
-  const LevelCamera camera = ToLevelCamera(K);
-  const Eigen::Matrix3f M =
-      (state.S_other_ref.Scale() * state.S_other_ref.Rotation().Matrix()).cast<float>();
-  const Eigen::Vector3f t = state.S_other_ref.Translation().cast<float>();
-  const float gain = state.affine.Gain();
-  const PhotometricModel model{M,
-                               t,
-                               gain,
-                               state.affine.b,
-                               options.pixel_noise_sigma * options.pixel_noise_sigma,
-                               options.huber_threshold};
+// Points [first, end) of a level, added in point order into their own partial sums.
+void EvaluateBlock(const Sim3TrackerOptions& options, const ReferenceLevel& points,
+                   const PyramidLevel& image, const LevelCamera& camera, const DepthLevel& depth,
+                   const PhotometricModel& model, std::size_t first, std::size_t end,
+                   Evaluation* e) {
   const float good_sq = options.good_threshold * options.good_threshold;
-  Evaluation e;
   BlockAccumulator<kParams> block;
   const auto add = [&](std::size_t i, const Eigen::Vector3f& dr_dp, const Eigen::Vector3f& p,
                        float residual, float variance, float gradient_sq, const RobustWeight& w) {
@@ -123,20 +117,52 @@ Evaluation EvaluateLevel(const Sim3TrackerOptions& options, const ReferenceLevel
     J.head<3>() = dr_dp;
     J.segment<3>(3) = p.cross(dr_dp);
     J[6] = dr_dp.dot(p);
-    J[7] = -gain * points.intensity[i];
+    J[7] = -model.gain * points.intensity[i];
     J[8] = -1.0f;
     block.Add(J, residual, w.weight, w.cost);
-    ++e.in_view;
-    e.good += residual * residual < good_sq * variance;
-    e.sum_sq_residual += static_cast<double>(residual) * residual;
-    e.sum_gradient_sq += gradient_sq;
-    e.depth_residuals += AddDepthResidual(options, camera, depth, t.z(), p, points.idepth[i],
-                                          points.variance[i], &block);
+    ++e->in_view;
+    e->good += residual * residual < good_sq * variance;
+    e->sum_sq_residual += static_cast<double>(residual) * residual;
+    e->sum_gradient_sq += gradient_sq;
+    e->depth_residuals += AddDepthResidual(options, camera, depth, model.t.z(), p, points.idepth[i],
+                                           points.variance[i], &block);
   };
   const PhotometricPoints soa{points.ray_x.data(), points.ray_y.data(), points.idepth.data(),
                               points.variance.data(), points.intensity.data()};
-  ForEachPhotometricTerm(image, camera, model, soa, 0, points.Size(), add);
-  block.FlushInto(&e.equations);
+  ForEachPhotometricTerm(image, camera, model, soa, first, end, add);
+  block.FlushInto(&e->equations);
+}
+
+Evaluation EvaluateLevel(const Sim3TrackerOptions& options, const ReferenceLevel& points,
+                         const PyramidLevel& image, const PinholeCamera& K, const DepthLevel& depth,
+                         const State& state) {
+  const LevelCamera camera = ToLevelCamera(K);
+  const Eigen::Matrix3f M =
+      (state.S_other_ref.Scale() * state.S_other_ref.Rotation().Matrix()).cast<float>();
+  const Eigen::Vector3f t = state.S_other_ref.Translation().cast<float>();
+  const PhotometricModel model{M,
+                               t,
+                               state.affine.Gain(),
+                               state.affine.b,
+                               options.pixel_noise_sigma * options.pixel_noise_sigma,
+                               options.huber_threshold};
+  // Blocks of a fixed size in parallel, added in block order: the same sums for any number
+  // of threads.
+  const std::size_t num_blocks = (points.Size() + kBlockSize - 1) / kBlockSize;
+  std::vector<Evaluation> blocks(num_blocks);
+  tbb::parallel_for(std::size_t{0}, num_blocks, [&](std::size_t b) {
+    EvaluateBlock(options, points, image, camera, depth, model, b * kBlockSize,
+                  std::min(points.Size(), (b + 1) * kBlockSize), &blocks[b]);
+  });
+  Evaluation e;
+  for (const Evaluation& block : blocks) {
+    e.equations += block.equations;
+    e.in_view += block.in_view;
+    e.good += block.good;
+    e.depth_residuals += block.depth_residuals;
+    e.sum_sq_residual += block.sum_sq_residual;
+    e.sum_gradient_sq += block.sum_gradient_sq;
+  }
   return e;
 }
 

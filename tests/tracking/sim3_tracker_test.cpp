@@ -4,6 +4,7 @@
 #include "tracking/sim3_tracker.hpp"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <Eigen/Eigenvalues>
 
@@ -69,6 +70,22 @@ TEST_F(Sim3TrackerTest, RecoversScaleChange) {
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 7, 7>> eig(result.information);
   EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0);
   EXPECT_TRUE(result.information.isApprox(result.information.transpose(), 1e-9));
+}
+
+TEST_F(Sim3TrackerTest, SameResultForAnyThreadCount) {
+  // Points are evaluated in parallel blocks whose sums are added in block order.
+  const auto track = [&](int threads) {
+    Sim3TrackingResult result;
+    tbb::task_arena(threads).execute(
+        [&] { result = Sim3Tracker().Track(*ref_a_, *ref_b_, Guess()); });
+    return result;
+  };
+  const Sim3TrackingResult one = track(1), two = track(2);
+  ASSERT_EQ(one.status, TrackingStatus::kOk);
+  EXPECT_EQ(one.S_ref_other.Log(), two.S_ref_other.Log());
+  EXPECT_EQ(one.information, two.information);
+  EXPECT_EQ(one.stats.iterations, two.stats.iterations);
+  EXPECT_EQ(one.depth_residuals, two.depth_residuals);
 }
 
 TEST_F(Sim3TrackerTest, WithoutDepthResidualsScaleIsUnobservable) {
