@@ -78,6 +78,12 @@ System::BufferedPoses System::KeepTheBetterStart(const std::shared_ptr<const Fra
   // the geometric thresholds; the pair's depth, refined by the same frames, then explains
   // them with a clearly lower residual. Measured in docs/configuration.md.
   BufferedPoses random_poses, pair_poses;
+  if (!(options_.auto_pair_residual_ratio > 0.0)) {  // no comparison: the pair's start
+    StartFromPair(pair_frame, pair);
+    RefineWithBufferedFrames();
+    BufferedResidual(&pair_poses);
+    return pair_poses;
+  }
   const double random_residual = BufferedResidual(&random_poses);
   StartSnapshot random_start = SaveStart();
   StartFromPair(pair_frame, pair);

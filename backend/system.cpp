@@ -37,8 +37,8 @@ void SystemOptions::Check() const {
   CheckOption(auto_max_rotation_deg > 0.0, "SystemOptions", "auto_max_rotation_deg", "must be > 0");
   CheckOption(auto_max_direction_deg > 0.0, "SystemOptions", "auto_max_direction_deg",
               "must be > 0");
-  CheckOption(auto_pair_residual_ratio > 0.0, "SystemOptions", "auto_pair_residual_ratio",
-              "must be > 0");
+  CheckOption(auto_pair_residual_ratio >= 0.0, "SystemOptions", "auto_pair_residual_ratio",
+              "must be >= 0 (0: no comparison)");
   CheckOption(restart_after_lost >= 1, "SystemOptions", "restart_after_lost", "must be >= 1");
   CheckOption(max_start_exposure_change > 1.0 && std::isfinite(max_start_exposure_change),
               "SystemOptions", "max_start_exposure_change", "must be > 1 and finite");

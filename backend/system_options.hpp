@@ -70,10 +70,12 @@ struct SystemOptions {
   /// than this and the translation directions by less than `auto_max_direction_deg`.
   double auto_max_rotation_deg = 2.5;
   double auto_max_direction_deg = 60.0;
-  /// Auto, when the geometry agrees: the pair's start replaces the random one only if its
-  /// mean residual over the buffered frames is below this fraction of the random start's
-  /// (measured ratios: 0.61-0.71 where the pair is right, 1.04-1.56 where random is).
-  double auto_pair_residual_ratio = 0.9;
+  /// Auto, when the geometry agrees: 0 keeps the pair's start (refined by the buffered
+  /// frames); a value > 0 keeps it only if its mean residual over the buffered frames is
+  /// below this fraction of the random start's (docs/configuration.md, "Choosing the
+  /// initialisation": since the sub-pixel pair, 0.9 kept the worse start on most sequences
+  /// where the two differ).
+  double auto_pair_residual_ratio = 0.0;
   /// The first keyframe needs at least this share of its pixels with enough gradient for
   /// depth (a dark or blank first frame is skipped and reported lost).
   double min_start_texture = 0.01;

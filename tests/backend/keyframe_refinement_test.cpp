@@ -167,11 +167,13 @@ TEST_F(KeyframeRefinementTest, StaysNearTheTruth) {
   EXPECT_LT(ShapeError(r.idepth, truth_), 0.01);
 }
 
-double RunAtePercent(const std::string& dataset, const std::string& out, bool refine) {
+double RunAtePercent(const std::string& dataset, const std::string& out, bool refine,
+                     Initialization initialization = Initialization::kAuto) {
   RunOptions run;
   run.dataset = dataset;
   run.out_dir = out;
   run.system.start_refinement.enabled = refine;
+  run.system.initialization = initialization;
   RunDataset(run);
   return Evaluate(ReadTumTrajectory(out + "/trajectory.txt"),
                   ReadTumTrajectory(dataset + "/groundtruth.txt"), {})
@@ -179,9 +181,11 @@ double RunAtePercent(const std::string& dataset, const std::string& out, bool re
 }
 
 TEST(StartRefinement, ImprovesAHandHeldStart) {
-  // Seed 3, the judging set's hand-held room (docs/benchmarks.md, "Start refinement"). Seed 2
-  // is not improved: its start is replaced by the two-view pair, a path the refinement does
-  // not take yet (0.288% either way).
+  // Seed 3, the judging set's hand-held room (docs/benchmarks.md, "Start refinement"), from
+  // random depth: 1.37% of path, refined 0.22%. The automatic start keeps the two-view pair
+  // here since 2026-12-03 (0.31%, refined 0.23%). Seed 2 is not improved: its start is
+  // replaced by the two-view pair, a path the refinement does not take yet (0.288% either
+  // way).
   const test::TempDirAt dir("parallax_start_refinement");
   synth::SynthOptions options;
   options.scene = "room";
@@ -189,8 +193,9 @@ TEST(StartRefinement, ImprovesAHandHeldStart) {
   options.frames = 90;
   options.seed = 3;
   synth::WriteSyntheticSequence(options, dir.File("seq"));
-  const double off = RunAtePercent(dir.File("seq"), dir.File("off"), false);
-  const double on = RunAtePercent(dir.File("seq"), dir.File("on"), true);
+  const double off =
+      RunAtePercent(dir.File("seq"), dir.File("off"), false, Initialization::kRandom);
+  const double on = RunAtePercent(dir.File("seq"), dir.File("on"), true, Initialization::kRandom);
   RecordProperty("ate_percent_off", std::to_string(off));
   RecordProperty("ate_percent_on", std::to_string(on));
   EXPECT_LT(on, 0.5 * off);
