@@ -48,9 +48,12 @@ DepthUpdateStats Mapper::Update(const Frame& frame, const SE3d& T_kf_update,
 
 std::pair<InverseDepthMap, float> Mapper::Propagate(const std::shared_ptr<const Frame>& frame,
                                                     const TrackingResult& tracked,
-                                                    PropagationStats* stats) const {
-  InverseDepthMap next = depth_filter_.Propagate(*map_, frame, tracked.T_kf_frame.Inverse(),
-                                                 tracked.affine.Gain(), tracked.affine.b, stats);
+                                                    PropagationStats* stats) {
+  // The current map is finished next (or, if this throws, updated again with new memory):
+  // its working memory moves on to the new map.
+  InverseDepthMap next =
+      depth_filter_.Propagate(*map_, frame, tracked.T_kf_frame.Inverse(), tracked.affine.Gain(),
+                              tracked.affine.b, stats, std::move(map_->scratch));
   const float s = depth_filter_.NormalizeScale(&next);
   return {std::move(next), s};
 }

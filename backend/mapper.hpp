@@ -45,11 +45,12 @@ class Mapper {
   DepthUpdateStats Update(const Frame& frame, const SE3d& T_kf_update,
                           const TrackingResult& tracked);
   /// The depth of a new keyframe at `frame` (propagated and scale-normalised) and the scale s
-  /// the normalisation multiplied inverse depths by. Throws NumericalDivergence when the
-  /// propagated map diverged (its mean inverse depth is not finite).
+  /// the normalisation multiplied inverse depths by; the new map takes the current one's
+  /// working memory. Throws NumericalDivergence when the propagated map diverged (its mean
+  /// inverse depth is not finite).
   std::pair<InverseDepthMap, float> Propagate(const std::shared_ptr<const Frame>& frame,
                                               const TrackingResult& tracked,
-                                              PropagationStats* stats = nullptr) const;
+                                              PropagationStats* stats = nullptr);
   /// The current keyframe as the graph keeps it (frozen sparse depth, image, reference).
   std::shared_ptr<Keyframe> Freeze() const;
   /// The current map becomes the newest recent one (the oldest beyond the limit is dropped);

@@ -22,10 +22,12 @@ void Invalidate(InverseDepthMap* map, std::size_t i) {
 constexpr std::size_t Idx(int i) { return static_cast<std::size_t>(i); }
 
 /// In place: each pixel becomes the sum of the 5x5 window around it (pixels within 2 of the
-/// border, whose window leaves the image, become 0; callers skip them). Rows in parallel.
-void BoxSum5x5(int w, int h, std::vector<float>* image) {
+/// border, whose window leaves the image, become 0; callers skip them). Rows in parallel;
+/// `row_sums` is working memory.
+void BoxSum5x5(int w, int h, std::vector<float>* image, std::vector<float>* row_sums) {
   std::vector<float>& v = *image;
-  std::vector<float> rows(v.size(), 0.0f);
+  std::vector<float>& rows = *row_sums;
+  rows.resize(v.size());  // only the entries written below are read
   const auto at = [w](int x, int y) { return static_cast<std::size_t>(y) * Idx(w) + Idx(x); };
   tbb::parallel_for(0, h, [&](int y) {
     for (int x = 2; x < w - 2; ++x) {
@@ -281,16 +283,24 @@ int DepthFilter::FillHoles(InverseDepthMap* map) const {
   // Sums over the valid pixels of each 5x5 window of validity, inverse variance and inverse
   // depth / variance: box filters of the masked maps (separable, a few additions per pixel
   // instead of 25 neighbour visits for each of the ~200k empty eligible pixels).
-  std::vector<float> support(n, 0.0f), sum_w(n, 0.0f), sum_wd(n, 0.0f);
+  // The map's working memory: every entry is written below.
+  std::vector<float>& support = map->scratch.fill[0];
+  std::vector<float>& sum_w = map->scratch.fill[1];
+  std::vector<float>& sum_wd = map->scratch.fill[2];
+  std::vector<float>& row_sums = map->scratch.fill[3];
+  for (std::vector<float>* plane : {&support, &sum_w, &sum_wd}) plane->resize(n);
   tbb::parallel_for(0, h, [&](int y) {
     for (std::size_t i = map->Index(0, y), end = i + Idx(w); i < end; ++i) {
+      support[i] = sum_w[i] = sum_wd[i] = 0.0f;
       if (!map->valid[i]) continue;
       support[i] = map->validity[i];
       sum_w[i] = 1.0f / map->variance[i];
       sum_wd[i] = map->idepth[i] * sum_w[i];
     }
   });
-  for (std::vector<float>* image : {&support, &sum_w, &sum_wd}) BoxSum5x5(w, h, image);
+  for (std::vector<float>* image : {&support, &sum_w, &sum_wd}) {
+    BoxSum5x5(w, h, image, &row_sums);
+  }
   // The window sums were taken before any filling, so filling a pixel here changes no other
   // pixel's decision: rows in parallel, counted in row order.
   std::vector<int> filled_in_row(Idx(h), 0);

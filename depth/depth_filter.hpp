@@ -62,11 +62,13 @@ class DepthFilter {
 
   /// Moves the map into a new keyframe (T_new_old: old keyframe -> new), transporting
   /// variances ((d_new/d_old)^4), resolving collisions (inconsistent: keep the nearer;
-  /// consistent: fuse), then regularises and fills holes.
+  /// consistent: fuse), then regularises and fills holes. `scratch` becomes the new map's
+  /// working memory: pass the old map's when it is not updated again, so that no keyframe
+  /// allocates its own.
   InverseDepthMap Propagate(const InverseDepthMap& old_map,
                             const std::shared_ptr<const Frame>& new_keyframe, const SE3d& T_new_old,
                             float gain = 1.0f, float offset = 0.0f,
-                            PropagationStats* stats = nullptr) const;
+                            PropagationStats* stats = nullptr, MapScratch scratch = {}) const;
 
   /// Rescales the map so the mean smoothed inverse depth is 1 and returns the factor s applied
   /// (idepth x s). The keyframe's world scale changes by 1/s; its Sim(3) pose must take it.

@@ -1,6 +1,7 @@
 #pragma once
 // Per-keyframe inverse-depth map, structure-of-arrays over the keyframe's level-0 pixels.
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -12,8 +13,9 @@
 
 namespace parallax {
 
-/// Working memory of the filter's passes over a map (DepthFilter::Regularize), kept with the
-/// map so that a stereo update allocates nothing. Not map state: a copy starts empty, and
+/// Working memory of the filter's passes over a map (DepthFilter::Regularize and FillHoles),
+/// kept with the map so that a stereo update allocates nothing, and handed on to the map
+/// propagated from it (DepthFilter::Propagate). Not map state: a copy starts empty, and
 /// Release() returns the memory of a map that is no longer updated.
 class MapScratch {
  public:
@@ -28,6 +30,9 @@ class MapScratch {
 
   RegularizeInputs regularize;     ///< the kernel's per-pixel inputs
   std::vector<std::uint8_t> keep;  ///< the regularisation's verdict per pixel
+  /// Hole filling's window sums (support, inverse variance, inverse depth / variance) and
+  /// its box filter's row sums.
+  std::array<std::vector<float>, 4> fill;
 };
 
 /// Per-pixel state of the inverse-depth filter (index = y * width + x). A pixel has an

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "core/check.hpp"
@@ -104,9 +105,10 @@ void Land(const InverseDepthMap& old_map, const Landing& landing, InverseDepthMa
 InverseDepthMap DepthFilter::Propagate(const InverseDepthMap& old_map,
                                        const std::shared_ptr<const Frame>& new_keyframe,
                                        const SE3d& T_new_old, float gain, float offset,
-                                       PropagationStats* stats) const {
+                                       PropagationStats* stats, MapScratch scratch) const {
   CheckArgument(new_keyframe != nullptr, "DepthFilter::Propagate: no keyframe");
   InverseDepthMap map(new_keyframe, options_);
+  map.scratch = std::move(scratch);
   CheckArgument(map.Width() == old_map.Width() && map.Height() == old_map.Height(),
                 "DepthFilter::Propagate: keyframe sizes differ");
   PropagationStats local;
