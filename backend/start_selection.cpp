@@ -1,6 +1,9 @@
 // System: choosing between the random start and the two-view start when their geometry
 // agrees (docs/configuration.md, "Choosing the initialisation").
 
+#include <optional>
+#include <utility>
+
 #include "backend/system.hpp"
 
 namespace parallax {
@@ -73,26 +76,24 @@ void System::RefineWithBufferedFrames() {
 
 System::BufferedPoses System::KeepTheBetterStart(const std::shared_ptr<const Frame>& pair_frame,
                                                  const TwoViewPair& pair) {
-  // A random start can converge to a smoothly distorted depth (on purely sideways motion,
-  // with noise or exposure changes) that still tracks "ok" and agrees with the pair within
-  // the geometric thresholds; the pair's depth, refined by the same frames, then explains
-  // them with a clearly lower residual. Measured in docs/configuration.md.
+  // The pair's start, refined by the buffered frames, is kept (docs/configuration.md). With
+  // auto_pair_residual_ratio > 0 it must also explain the frames with a clearly lower
+  // residual than the random start, which is saved first and restored otherwise.
+  const bool compare = options_.auto_pair_residual_ratio > 0.0;
   BufferedPoses random_poses, pair_poses;
-  if (!(options_.auto_pair_residual_ratio > 0.0)) {  // no comparison: the pair's start
-    StartFromPair(pair_frame, pair);
-    RefineWithBufferedFrames();
-    BufferedResidual(&pair_poses);
-    return pair_poses;
+  double random_residual = 0.0;
+  std::optional<StartSnapshot> random_start;
+  if (compare) {
+    random_residual = BufferedResidual(&random_poses);
+    random_start = SaveStart();
   }
-  const double random_residual = BufferedResidual(&random_poses);
-  StartSnapshot random_start = SaveStart();
   StartFromPair(pair_frame, pair);
   RefineWithBufferedFrames();
   const double pair_residual = BufferedResidual(&pair_poses);
   // Near-equal residuals are no evidence against the random start, whose depth has seen the
   // frames live: the pair must be clearly better.
-  if (!(pair_residual < options_.auto_pair_residual_ratio * random_residual)) {
-    RestoreStart(std::move(random_start));
+  if (compare && !(pair_residual < options_.auto_pair_residual_ratio * random_residual)) {
+    RestoreStart(std::move(*random_start));
     return random_poses;
   }
   return pair_poses;

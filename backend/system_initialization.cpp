@@ -83,8 +83,8 @@ std::vector<RevisedPose> System::FinishInitialisation() {
   bool replaced = false;
   std::optional<BufferedPoses> poses;  // the buffered frames tracked against the final map
   if (start_ == StartState::kRandomPairHeld) {
-    // The converged random start must agree with the independent two-view geometry, and
-    // then explain the frames at least as well as a start from the pair does.
+    // The converged random start must agree with the independent two-view geometry; if it
+    // does, the pair's start refined by the same frames is kept (KeepTheBetterStart).
     const auto& [pair_frame, pair] = *pending_pair_;
     SE3d guess;
     for (const auto& [frame, T_kf_frame] : initial_frames_) {
@@ -95,7 +95,7 @@ std::vector<RevisedPose> System::FinishInitialisation() {
       revised = StartFromPair(pair_frame, pair);
       replaced = true;
     } else {
-      // Geometry agrees: the start whose depth explains the frames better is kept.
+      // Geometry agrees: the refined pair (or, with a residual comparison, the better one).
       poses = KeepTheBetterStart(pair_frame, pair);
     }
     pending_pair_.reset();
