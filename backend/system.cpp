@@ -26,6 +26,13 @@ void SystemOptions::Check() const {
   update_direction.Check();
   start_refinement.Check();
   CheckOption(start_refinement_frames >= 2, "SystemOptions", "start_refinement_frames", ">= 2");
+  keyframe_refinement.Check();
+  CheckOption(keyframe_refinement_frames >= 2, "SystemOptions", "keyframe_refinement_frames",
+              ">= 2");
+  CheckOption(keyframe_refinement_min_window >= 2, "SystemOptions",
+              "keyframe_refinement_min_window", ">= 2");
+  CheckOption(keyframe_window_capacity >= keyframe_refinement_frames, "SystemOptions",
+              "keyframe_window_capacity", ">= keyframe_refinement_frames");
   bootstrap.Check();
   quality.Check();
   backend.Check();
@@ -79,7 +86,8 @@ System::System(const PinholeCamera& camera, const SystemOptions& options)
       backend_(options.backend, KeyframeBuildOptions{camera, options.pyramid, options_.reference}),
       place_(Vocabulary::Default(), options.loop_closure.place),
       loop_closer_(options.loop_closure, &place_, camera),
-      relocalizer_(options.relocalization, camera) {
+      relocalizer_(options.relocalization, camera),
+      window_(static_cast<std::size_t>(std::max(2, options.keyframe_window_capacity))) {
   options_.Check();
   chain_information_ = backend_.FallbackInformation();
   if (options_.realtime.enabled) StartRealtime();
@@ -159,6 +167,7 @@ void System::ClearMap() {
     loop_closer_.Clear();
   }
   mapper_.Clear();
+  window_.Clear();
   current_ = CurrentKeyframe{};
   ++map_generation_;
 }
@@ -305,6 +314,9 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& 
         mapper_.Update(*frame, T_kf_update, tracked).diverged;
     ++depth_updates_;
     if (!want_keyframe) mapper_.PublishReference();
+    if (initialised && options_.keyframe_refinement.enabled) {
+      window_.Add(mapper_.KeyframeId(), frame, tracked.T_kf_frame);
+    }
   }
   if (start_ != StartState::kInitialised) {
     BufferInitialFrame(frame, tracked.T_kf_frame);
@@ -320,6 +332,7 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& 
 
 void System::SwitchKeyframe(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
                             const TrackingResult& tracked, FrameResult* result) {
+  RefineLeavingKeyframe();
   std::optional<std::pair<InverseDepthMap, float>> propagated;
   try {
     PropagationStats stats;

@@ -17,6 +17,7 @@
 #include "backend/graph_backend.hpp"
 #include "backend/keyframe_graph.hpp"
 #include "backend/keyframe_refinement.hpp"
+#include "backend/keyframe_window.hpp"
 #include "backend/loop_closer.hpp"
 #include "backend/mapper.hpp"
 #include "backend/place_recognizer.hpp"
@@ -238,6 +239,11 @@ class System {
   void RefineWithBufferedFrames();
   /// Joint refinement of the first keyframe and the buffered frames (their poses updated).
   void RefineStart(BufferedPoses* poses);
+  /// Before the current keyframe is left: when SystemOptions::keyframe_refinement is on and
+  /// its window is long enough, its depth is refined jointly with the window's frames
+  /// (system_refinement.cpp), so the next keyframe inherits the refined depth. The window is
+  /// emptied either way.
+  void RefineLeavingKeyframe();
   /// Writes raw and smoothed inverse depths of the current map's `pixel`s and publishes it.
   void SetEstimates(const std::vector<std::int32_t>& pixel, const std::vector<float>& raw,
                     const std::vector<float>& smoothed);
@@ -319,6 +325,8 @@ class System {
   /// tracked again against the converged depth; the first keyframe is not among them.
   std::vector<std::pair<std::shared_ptr<const Frame>, SE3d>> initial_frames_;
   int lost_in_a_row_ = 0;
+  /// Frames that updated the current keyframe's depth (only with keyframe_refinement on).
+  KeyframeWindow window_;
   /// The map new keyframes join, and the id the next new map gets.
   int current_map_ = 0;
   int next_map_ = 1;

@@ -224,54 +224,6 @@ bool System::RandomStartAgrees(const SE3d& T_kf_frame, const TwoViewPair& pair) 
          direction_deg < options_.auto_max_direction_deg;
 }
 
-void System::RefineStart(BufferedPoses* poses) {
-  if (!options_.start_refinement.enabled) return;
-  InverseDepthMap& map = mapper_.Map();
-  std::vector<std::int32_t> pixel;
-  std::vector<float> idepth;
-  for (std::size_t i = 0; i < map.valid.size(); ++i) {
-    if (map.valid[i] == 0) continue;
-    pixel.push_back(static_cast<std::int32_t>(i));
-    idepth.push_back(map.idepth_smoothed[i]);
-  }
-  // At most max_frames buffered frames, spread over the window with the last (the widest
-  // baseline) included: the joint problem's cost grows with the square of its frames.
-  std::vector<std::size_t> posed;
-  for (std::size_t i = 0; i < poses->size(); ++i) {
-    if ((*poses)[i]) posed.push_back(i);
-  }
-  const std::size_t m =
-      std::min(posed.size(), static_cast<std::size_t>(options_.start_refinement_frames));
-  if (m < 2) return;
-  std::vector<RefinementFrame> frames;
-  std::vector<std::size_t> index;
-  for (std::size_t k = m; k-- > 0;) {
-    const std::size_t i = posed[posed.size() - 1 - (k * (posed.size() - 1)) / (m - 1)];
-    frames.push_back({initial_frames_[i].first.get(), *(*poses)[i]});
-    index.push_back(i);
-  }
-  const KeyframeRefinementResult r =
-      RefineKeyframe(map.Keyframe(), pixel, idepth, frames, options_.start_refinement);
-  SetEstimates(pixel, r.idepth, r.idepth);
-  // Every buffered frame tracked against the refined depth (the refined poses as guesses).
-  for (std::size_t j = 0; j < index.size(); ++j) (*poses)[index[j]] = r.T_kf_frame[j];
-  for (const std::size_t i : posed) {
-    if (const auto again = TrackAgain(*initial_frames_[i].first, *(*poses)[i])) {
-      (*poses)[i] = again;
-    }
-  }
-}
-
-void System::SetEstimates(const std::vector<std::int32_t>& pixel, const std::vector<float>& raw,
-                          const std::vector<float>& smoothed) {
-  InverseDepthMap& map = mapper_.Map();
-  for (std::size_t k = 0; k < pixel.size(); ++k) {
-    map.idepth[static_cast<std::size_t>(pixel[k])] = raw[k];
-    map.idepth_smoothed[static_cast<std::size_t>(pixel[k])] = smoothed[k];
-  }
-  mapper_.PublishReference();
-}
-
 std::vector<RevisedPose> System::StartFromPair(const std::shared_ptr<const Frame>& pair_frame,
                                                const TwoViewPair& pair) {
   // Stereo with the pair's pose creates the keyframe's depth from scratch (full-range
