@@ -133,9 +133,9 @@ struct SystemOptions {
   KeyframeRefinementOptions keyframe_refinement;
   /// ... with at most this many of the window's frames (spread, the newest included) ...
   int keyframe_refinement_frames = 6;
-  /// ... when at least this many frames updated the keyframe (short windows have too little
-  /// baseline: with 3 or more, the real clips got worse, TUM 6.0 -> 9.9 mm, KITTI 0.52 ->
-  /// 0.80% of path, whose windows are 3-5 frames long).
+  /// ... when at least this many frames updated the keyframe: short windows have too little
+  /// baseline (refining them made the real clips, whose windows are 3-5 frames long, worse:
+  /// docs/benchmarks.md, "Refining every keyframe").
   int keyframe_refinement_min_window = 9;
   /// Frames of the window held for it (each holds its pyramid, ~6 MB at 640x480); a longer
   /// window is thinned evenly (KeyframeWindow).

@@ -84,15 +84,15 @@ void System::RefineLeavingKeyframe() {
       RefineKeyframe(map.Keyframe(), pixel, idepth, frames, options_.keyframe_refinement);
   window_.Clear();
   // The refined values become the filter's estimates and are regularised again, as after a
-  // depth update (writing them into the smoothed map too was measured worse on the tuning
-  // orbit: 0.30 against 0.21% of path).
+  // depth update (writing them into the smoothed map too measured worse: docs/benchmarks.md,
+  // "Refining every keyframe").
   for (std::size_t k = 0; k < pixel.size(); ++k) {
     map.idepth[static_cast<std::size_t>(pixel[k])] = r.idepth[k];
   }
   mapper_.Filter().Regularize(&map);
   // The frames' refined poses are not used: the keyframe that follows starts from its
-  // tracked pose (moving it too gave 0.21-0.50% of path on the tuning orbit, depending on
-  // which frames the window held, against 0.35-0.41% without: docs/benchmarks.md).
+  // tracked pose (moving it too made the result depend more on which frames the window
+  // held: docs/benchmarks.md, "Refining every keyframe").
 }
 
 }  // namespace parallax
