@@ -349,6 +349,15 @@ int RefinePoint(const std::vector<FrameWarp>& warps, float ray_x, float ray_y, f
 
 }  // namespace
 
+std::vector<std::size_t> SpreadIndices(std::size_t n, std::size_t count) {
+  std::vector<std::size_t> indices;
+  const std::size_t m = std::min(n, count);
+  for (std::size_t k = m; k-- > 0;) {
+    indices.push_back(n - 1 - (k * (n - 1)) / std::max<std::size_t>(m - 1, 1));
+  }
+  return indices;
+}
+
 KeyframeRefinementResult RefineKeyframe(const Frame& keyframe,
                                         const std::vector<std::int32_t>& pixel,
                                         const std::vector<float>& idepth,
@@ -385,12 +394,11 @@ KeyframeRefinementResult RefineKeyframe(const Frame& keyframe,
   // Points are independent: the parallel loop is deterministic.
   std::vector<RefinementFrame> point_frames;
   std::vector<SE3d> point_poses;
-  const std::size_t n = frames.size();
-  const std::size_t m = std::min<std::size_t>(n, static_cast<std::size_t>(options.point_frames));
-  for (std::size_t k = 0; k < m; ++k) {
-    const std::size_t j = n - 1 - (k * (n - 1)) / std::max<std::size_t>(m - 1, 1);
-    point_frames.push_back(frames[j]);
-    point_poses.push_back(result.T_kf_frame[j]);
+  const std::vector<std::size_t> spread =
+      SpreadIndices(frames.size(), static_cast<std::size_t>(options.point_frames));
+  for (auto j = spread.rbegin(); j != spread.rend(); ++j) {  // the newest first
+    point_frames.push_back(frames[*j]);
+    point_poses.push_back(result.T_kf_frame[*j]);
   }
   std::vector<int> seen(pixel.size(), 0);
   for (int level = coarsest; level >= 0; --level) {

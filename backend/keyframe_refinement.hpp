@@ -3,6 +3,7 @@
 // that observed it: a small bundle adjustment over the keyframe's window
 // (docs/math/keyframe_refinement.md).
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -62,6 +63,11 @@ struct KeyframeRefinementResult {
   double final_cost = 0.0;    ///< ... and after
   int iterations = 0;         ///< accepted joint steps over all levels
 };
+
+/// Indices of at most `count` of `n` items spread evenly over them, oldest first, the first
+/// and the newest (n - 1, the widest baseline) always included: how the refinements choose
+/// frames from a window. Empty when n == 0.
+std::vector<std::size_t> SpreadIndices(std::size_t n, std::size_t count);
 
 /// Refines `idepth` (inverse depths, keyframe units, of the level-0 pixels `pixel` =
 /// y * width + x) and the frames' poses by minimising the Huber photometric error of every

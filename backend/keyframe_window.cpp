@@ -47,12 +47,8 @@ std::vector<RefinementFrame> KeyframeWindow::Select(std::size_t count) const {
     kept.push_back(&newest_);
   }
   std::vector<RefinementFrame> frames;
-  const std::size_t n = kept.size();
-  if (n == 0) return frames;
-  const std::size_t m = std::min(n, count);
-  for (std::size_t k = m; k-- > 0;) {
-    const Entry& e = *kept[n - 1 - (k * (n - 1)) / std::max<std::size_t>(m - 1, 1)];
-    frames.push_back({e.frame.get(), e.T_kf_frame});
+  for (const std::size_t i : SpreadIndices(kept.size(), count)) {
+    frames.push_back({kept[i]->frame.get(), kept[i]->T_kf_frame});
   }
   return frames;
 }

@@ -34,13 +34,12 @@ void System::RefineStart(BufferedPoses* poses) {
   for (std::size_t i = 0; i < poses->size(); ++i) {
     if ((*poses)[i]) posed.push_back(i);
   }
-  const std::size_t m =
-      std::min(posed.size(), static_cast<std::size_t>(options_.start_refinement_frames));
-  if (m < 2) return;
+  if (posed.size() < 2 || options_.start_refinement_frames < 2) return;
   std::vector<RefinementFrame> frames;
   std::vector<std::size_t> index;
-  for (std::size_t k = m; k-- > 0;) {
-    const std::size_t i = posed[posed.size() - 1 - (k * (posed.size() - 1)) / (m - 1)];
+  for (const std::size_t k :
+       SpreadIndices(posed.size(), static_cast<std::size_t>(options_.start_refinement_frames))) {
+    const std::size_t i = posed[k];
     frames.push_back({initial_frames_[i].first.get(), *(*poses)[i]});
     index.push_back(i);
   }
