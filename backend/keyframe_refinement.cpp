@@ -26,6 +26,8 @@ void KeyframeRefinementOptions::Check() const {
               "in (0, 1)");
   CheckOption(initial_lambda > 0.0, s, "initial_lambda", "> 0");
   CheckOption(max_pixel_step > 0.0, s, "max_pixel_step", "> 0");
+  CheckOption(max_point_relative_sigma >= 0.0f && std::isfinite(max_point_relative_sigma), s,
+              "max_point_relative_sigma", "finite and >= 0 (0 disables)");
 }
 
 namespace {
@@ -347,6 +349,22 @@ int RefinePoint(const std::vector<FrameWarp>& warps, float ray_x, float ray_y, f
   return seen;
 }
 
+/// Whether the frames determine a point's inverse depth to `max_relative_sigma`: the
+/// information sum_j (dr_j / dd)^2 / sigma^2 at pixel noise (no robust weight: the question is
+/// what the geometry and the gradient allow, not how well the current value fits) against
+/// 1 / (max_relative_sigma * d)^2.
+bool Determined(const std::vector<FrameWarp>& warps, float ray_x, float ray_y, float idepth,
+                float reference, float noise_variance, double max_relative_sigma) {
+  double information = 0.0;
+  for (const FrameWarp& w : warps) {
+    Linearised l;
+    if (!Linearise(w, ray_x, ray_y, idepth, reference, noise_variance, &l)) continue;
+    information += static_cast<double>(l.dr_dd) * l.dr_dd / noise_variance;
+  }
+  const double max_sigma = max_relative_sigma * idepth;
+  return information * max_sigma * max_sigma >= 1.0;
+}
+
 }  // namespace
 
 std::vector<std::size_t> SpreadIndices(std::size_t n, std::size_t count) {
@@ -400,13 +418,28 @@ KeyframeRefinementResult RefineKeyframe(const Frame& keyframe,
     point_frames.push_back(frames[*j]);
     point_poses.push_back(result.T_kf_frame[*j]);
   }
+  // Points the frames cannot measure (no parallax, or their gradient across the epipolar
+  // lines) keep their value and are not iterated: alone, the photometric error moves them
+  // by noise (docs/math/keyframe_refinement.md, "The information gate").
+  std::vector<std::uint8_t> measured(pixel.size(), 1);
+  if (options.max_point_relative_sigma > 0.0f) {
+    const std::vector<FrameWarp> warps =
+        FittedWarps(point_frames, point_poses, 0, finest, refined, joint, options);
+    const float noise_variance = options.pixel_noise_sigma * options.pixel_noise_sigma;
+    tbb::parallel_for(std::size_t{0}, pixel.size(), [&](std::size_t i) {
+      measured[i] =
+          finest.reference[i] >= 0.0f &&
+          Determined(warps, finest.ray_x[i], finest.ray_y[i], refined[i], finest.reference[i],
+                     noise_variance, options.max_point_relative_sigma);
+    });
+  }
   std::vector<int> seen(pixel.size(), 0);
   for (int level = coarsest; level >= 0; --level) {
     const LevelPoints points = level == 0 ? finest : PreparePoints(keyframe, pixel, level);
     const std::vector<FrameWarp> warps =
         FittedWarps(point_frames, point_poses, level, points, refined, joint, options);
     tbb::parallel_for(std::size_t{0}, pixel.size(), [&](std::size_t i) {
-      if (points.reference[i] < 0.0f) return;
+      if (points.reference[i] < 0.0f || measured[i] == 0) return;
       seen[i] = RefinePoint(warps, points.ray_x[i], points.ray_y[i], points.reference[i], options,
                             &refined[i]);
     });

@@ -13,8 +13,8 @@
 namespace parallax {
 
 struct KeyframeRefinementOptions {
-  /// Off by default: on it gains 2-10x on hand-held renders but moves two judged tests past
-  /// their bounds (docs/benchmarks.md, "Start refinement").
+  /// Off by default (docs/benchmarks.md, "Start refinement" and "The start refinement's
+  /// information gate").
   bool enabled = false;
   /// Pyramid levels, coarse to fine: coarsest_level .. 0.
   int coarsest_level = 1;
@@ -36,6 +36,11 @@ struct KeyframeRefinementOptions {
   /// A point's inverse depth may change by at most this share; beyond, it keeps its value
   /// (a different minimum, not a correction).
   float max_relative_change = 0.25f;
+  /// A point is refined alone only when the frames determine it: the standard deviation its
+  /// photometric information implies at pixel noise, at its starting value on level 0, is at
+  /// most this share of its inverse depth. Points the frames see without parallax, or with
+  /// their gradient across the epipolar lines, keep their value. 0 disables the gate.
+  float max_point_relative_sigma = 0.0f;
   double initial_lambda = 1e-2;
   /// A point's inverse depth moves at most this far per step, in pixels of its largest image
   /// motion (the photometric linearisation holds within about a pixel).

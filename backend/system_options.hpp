@@ -120,7 +120,10 @@ struct SystemOptions {
   int initialization_updates = 20;
   /// When initialisation completes, the first keyframe's depth and the buffered frames'
   /// poses are refined jointly (docs/math/keyframe_refinement.md): the depth filter's
-  /// alternation leaves a smooth distortion (a tilt) that joint refinement removes.
+  /// alternation leaves a smooth distortion (a tilt) that joint refinement removes. Off by
+  /// default, and ungated when on (max_point_relative_sigma 0): the information gate trades
+  /// the hand-held renders' gain for the KITTI clip's (docs/benchmarks.md, "The start
+  /// refinement's information gate").
   KeyframeRefinementOptions start_refinement;
   /// ... on at most this many of the buffered frames (spread, the last included); all are
   /// then tracked again against the refined depth.
