@@ -232,6 +232,10 @@ TrackingResult Se3Tracker::TrackFrom(const TrackingReference& reference, const F
   return result;
 }
 
+double ConsistentPoints(const TrackingStats& stats) {
+  return stats.good_ratio * stats.points_in_view;
+}
+
 TrackingResult Se3Tracker::Track(const TrackingReference& reference, const Frame& frame,
                                  const std::vector<SE3d>& hypotheses,
                                  const AffineBrightness& affine_guess) {
@@ -263,9 +267,12 @@ TrackingResult Se3Tracker::Track(const TrackingReference& reference, const Frame
   }
   if (best_candidate != nullptr) {
     TrackingResult alternative = TrackFrom(reference, frame, *best_candidate, affine_guess);
-    const bool better =
-        alternative.status < best.status ||
-        (alternative.status == best.status && alternative.stats.good_ratio > best.stats.good_ratio);
+    // Of two results with the same status, the one that explains more of the map: the share
+    // of consistent points alone prefers a pose that sees fewer of them (docs/math/
+    // tracking.md, "Comparing two results").
+    const bool better = alternative.status < best.status ||
+                        (alternative.status == best.status &&
+                         ConsistentPoints(alternative.stats) > ConsistentPoints(best.stats));
     if (better) best = alternative;
   }
   best.stats.hypotheses_tried = static_cast<int>(candidates.size()) + 1;

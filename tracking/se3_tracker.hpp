@@ -122,6 +122,10 @@ class Se3Tracker {
   std::vector<LevelEvaluation> block_sums_;  // scratch, one per block of points
 };
 
+/// Points of the finest tracked level whose residual is consistent with the noise model
+/// (good ratio x points in view): how much of the map a result explains.
+double ConsistentPoints(const TrackingStats& stats);
+
 /// Motion hypotheses for the next frame from the last tracked pose and the last inter-frame
 /// motion T_prev_last (pose of the last frame in the previous one): constant velocity, half
 /// and double velocity, zero motion, and the keyframe pose itself.
