@@ -232,10 +232,6 @@ TrackingResult Se3Tracker::TrackFrom(const TrackingReference& reference, const F
   return result;
 }
 
-double ConsistentPoints(const TrackingStats& stats) {
-  return stats.good_ratio * stats.points_in_view;
-}
-
 TrackingResult Se3Tracker::Track(const TrackingReference& reference, const Frame& frame,
                                  const std::vector<SE3d>& hypotheses,
                                  const AffineBrightness& affine_guess) {
@@ -272,7 +268,7 @@ TrackingResult Se3Tracker::Track(const TrackingReference& reference, const Frame
     // tracking.md, "Comparing two results").
     const bool better = alternative.status < best.status ||
                         (alternative.status == best.status &&
-                         ConsistentPoints(alternative.stats) > ConsistentPoints(best.stats));
+                         alternative.stats.points_good > best.stats.points_good);
     if (better) best = alternative;
   }
   best.stats.hypotheses_tried = static_cast<int>(candidates.size()) + 1;

@@ -79,7 +79,8 @@ class Se3Tracker {
   /// Tracks `frame` starting from hypotheses[0] (T_kf_frame guesses, at least one). If that
   /// is not kOk, or kOk but suspect (suspect_good_ratio), the remaining hypotheses and small
   /// rotations around the first (and around a suspect result) are scored cheaply at the
-  /// coarsest level and the best is tracked fully; the better result wins.
+  /// coarsest level and the best is tracked fully; the better result wins (status, then
+  /// more consistent points).
   TrackingResult Track(const TrackingReference& reference, const Frame& frame,
                        const std::vector<SE3d>& hypotheses,
                        const AffineBrightness& affine_guess = {});
@@ -121,10 +122,6 @@ class Se3Tracker {
   Se3TrackerOptions options_;
   std::vector<LevelEvaluation> block_sums_;  // scratch, one per block of points
 };
-
-/// Points of the finest tracked level whose residual is consistent with the noise model
-/// (good ratio x points in view): how much of the map a result explains.
-double ConsistentPoints(const TrackingStats& stats);
 
 /// Motion hypotheses for the next frame from the last tracked pose and the last inter-frame
 /// motion T_prev_last (pose of the last frame in the previous one): constant velocity, half

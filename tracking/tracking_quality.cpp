@@ -7,6 +7,7 @@ namespace parallax {
 void FillPointStatistics(const PointSums& sums, std::size_t total_points, TrackingStats* stats) {
   const auto total = static_cast<double>(total_points);
   stats->points_in_view = sums.in_view;
+  stats->points_good = sums.good;
   stats->usage = total > 0 ? sums.in_view / total : 0.0;
   if (sums.in_view <= 0) return;
   stats->residual_rms = std::sqrt(sums.sum_sq_residual / sums.in_view);

@@ -32,6 +32,7 @@ struct TrackingStats {
   double usage = 0.0;             ///< fraction of the level's reference points in view
   double mean_gradient_sq = 0.0;  ///< mean |grad I_frame|^2 at the warped points
   int points_in_view = 0;
+  int points_good = 0;  ///< in-view points with |r / sigma| < good threshold (the ratio's count)
   std::array<int, kMaxPyramidLevels> iterations{};  ///< LM iterations per level
   int hypotheses_tried = 0;
   bool diverged = false;
