@@ -63,6 +63,19 @@ void SystemOptions::Check() const {
               "must be >= 1");
   CheckOption(initialization_updates >= 1, "SystemOptions", "initialization_updates",
               "must be >= 1");
+  CheckOption(early_keyframe_usage >= 0.0 && early_keyframe_usage < 1.0, "SystemOptions",
+              "early_keyframe_usage", "must be in [0, 1) (0 disables)");
+}
+
+bool SystemOptions::WantsKeyframe(int frames_in_keyframe, double relative_distance,
+                                  const TrackingStats& stats) const {
+  const bool view_degrades =
+      stats.usage < min_keyframe_usage || stats.good_ratio < min_keyframe_good_ratio;
+  // Early only from a consistent frame: the view leaves the keyframe, the pose is sound.
+  const bool soon_out_of_view =
+      stats.usage < early_keyframe_usage && stats.good_ratio >= min_keyframe_good_ratio;
+  return (frames_in_keyframe >= min_frames_per_keyframe || soon_out_of_view) &&
+         (view_degrades || relative_distance > keyframe_distance);
 }
 
 namespace {
@@ -298,11 +311,9 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& 
   // would be compared with, or replaced by, lives in that keyframe.
   const bool start_pending =
       start_ == StartState::kRandomPairSearch || start_ == StartState::kRandomPairHeld;
-  const bool view_degrades = tracked.stats.usage < options_.min_keyframe_usage ||
-                             tracked.stats.good_ratio < options_.min_keyframe_good_ratio;
-  bool want_keyframe = !start_pending &&
-                       tracker_.State().frames_in_keyframe >= options_.min_frames_per_keyframe &&
-                       (view_degrades || relative_distance > options_.keyframe_distance);
+  const bool want_keyframe =
+      !start_pending &&
+      options_.WantsKeyframe(tracker_.State().frames_in_keyframe, relative_distance, tracked.stats);
   if (tracked.status == TrackingStatus::kOk && relative_distance > options_.min_update_baseline) {
     // Only once initialised: the start's keyframe and its selection stay as they were.
     const bool initialised = start_ == StartState::kInitialised;

@@ -110,8 +110,12 @@ struct SystemOptions {
   /// keyframes are tried (from the pose propagated through the similarities, and from the
   /// keyframe's own pose); the first that tracks "ok" becomes the current keyframe again.
   int recent_keyframes = 4;
-  /// Frames tracked into a keyframe before it may be replaced.
+  /// Frames tracked into a keyframe before it may be replaced ...
   int min_frames_per_keyframe = 3;
+  /// ... unless fewer than this share of its points is in view: a fast turn leaves a keyframe
+  /// within two frames, and waiting for the third makes the next keyframe from a frame that
+  /// saw little of it (docs/math/tracking.md, "A sudden turn"). 0 disables.
+  double early_keyframe_usage = 0.3;
   /// The random start counts as initialised after this many depth updates of the first
   /// keyframe; the frames tracked before that are then tracked again against the converged
   /// depth and their poses revised (design.md section 3a). 20 (two thirds of a second at 30
@@ -165,6 +169,12 @@ struct SystemOptions {
   RealtimeOptions realtime;
 
   void Check() const;
+
+  /// The keyframe rule (both modes): whether a frame tracked `frames_in_keyframe` frames
+  /// into its keyframe, at `relative_distance` (|t_kf_frame| times the mean inverse depth),
+  /// with tracking statistics `stats`, should become the next keyframe.
+  bool WantsKeyframe(int frames_in_keyframe, double relative_distance,
+                     const TrackingStats& stats) const;
 };
 
 }  // namespace parallax

@@ -184,12 +184,9 @@ System::LiveStep System::TrackLive(const Frame& frame, const LiveSnapshot& snaps
   // when it is published.
   const TrackingResult& t = step.tracked;
   const double relative_distance = t.T_kf_frame.Translation().norm() * snapshot.mean_idepth;
-  const bool view_degrades = t.stats.usage < options_.min_keyframe_usage ||
-                             t.stats.good_ratio < options_.min_keyframe_good_ratio;
   const bool wants_keyframe =
       snapshot.initialised &&
-      live_->tracker.State().frames_in_keyframe >= options_.min_frames_per_keyframe &&
-      (view_degrades || relative_distance > options_.keyframe_distance);
+      options_.WantsKeyframe(live_->tracker.State().frames_in_keyframe, relative_distance, t.stats);
   step.keep = wants_keyframe && live_->keyframe_requested_in != snapshot.keyframe_id;
   const double f = options_.realtime.keyframe_wait_factor;
   step.overdue = wants_keyframe && !step.keep &&

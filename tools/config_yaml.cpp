@@ -83,6 +83,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"min_keyframe_good_ratio", Set(&o->min_keyframe_good_ratio)},
         {"min_update_baseline", Set(&o->min_update_baseline)},
         {"min_frames_per_keyframe", Set(&o->min_frames_per_keyframe)},
+        {"early_keyframe_usage", Set(&o->early_keyframe_usage)},
         {"recent_keyframes", Set(&o->recent_keyframes)},
         {"max_buffered_frames", Set(&o->max_buffered_frames)},
         {"max_buffered_megabytes", Set(&o->max_buffered_megabytes)},

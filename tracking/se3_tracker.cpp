@@ -245,6 +245,12 @@ TrackingResult Se3Tracker::Track(const TrackingReference& reference, const Frame
   std::vector<SE3d> candidates(hypotheses.begin() + 1, hypotheses.end());
   AddRotations(hypotheses.front(), options_.search_rotations_deg, &candidates);
   if (suspect) AddRotations(best.T_kf_frame, options_.search_rotations_deg, &candidates);
+  if (best.status != TrackingStatus::kLost) {
+    // A sudden turn: the first run often finds the rotation but lets the translation slide
+    // along the rotation-translation ambiguity; restarted from the motion model's
+    // translation it converges to the right basin (docs/math/tracking.md, "A sudden turn").
+    candidates.emplace_back(best.T_kf_frame.Rotation(), hypotheses.front().Translation());
+  }
   const int coarsest = reference.NumLevels() - 1;
   const AffineBrightness prior = options_.estimate_affine ? affine_guess : AffineBrightness{};
   double best_cost = std::numeric_limits<double>::infinity();

@@ -126,6 +126,32 @@ INSTANTIATE_TEST_SUITE_P(
              (c.exposure ? "_exposure" : "");
     });
 
+// The keyframe rule: a keyframe needs min_frames_per_keyframe frames, unless the view is
+// leaving it (fewer than early_keyframe_usage of its points in view) on a consistent frame.
+TEST(SystemOptions, AKeyframeComesEarlyOnlyWhenAConsistentViewLeavesIt) {
+  SystemOptions options;
+  TrackingStats leaving;
+  leaving.usage = 0.2;
+  leaving.good_ratio = 0.95;
+  const int second = options.min_frames_per_keyframe - 1;
+  EXPECT_TRUE(options.WantsKeyframe(second, 0.0, leaving));
+  TrackingStats degraded = leaving;  // degrades the view, but a third of it is still there
+  degraded.usage = 0.5;
+  EXPECT_FALSE(options.WantsKeyframe(second, 0.0, degraded));
+  EXPECT_TRUE(options.WantsKeyframe(options.min_frames_per_keyframe, 0.0, degraded));
+  TrackingStats inconsistent = leaving;  // the pose itself is in doubt: wait
+  inconsistent.good_ratio = 0.6;
+  EXPECT_FALSE(options.WantsKeyframe(second, 0.0, inconsistent));
+  TrackingStats steady = leaving;  // a well-covered view far enough away: the usual rule
+  steady.usage = 0.9;
+  EXPECT_FALSE(options.WantsKeyframe(second, 1.0, steady));
+  EXPECT_TRUE(options.WantsKeyframe(options.min_frames_per_keyframe, 1.0, steady));
+  options.early_keyframe_usage = 0.0;
+  EXPECT_FALSE(options.WantsKeyframe(second, 0.0, leaving));
+  options.early_keyframe_usage = 1.0;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+}
+
 TEST(Pipeline, AutoStartKeepsThePairWhenTheGeometryAgrees) {
   // Desk shake, seed 4: the random start converges to a depth that agrees with the pair's
   // geometry and explains the buffered frames almost as well (residual ratio 0.93), but its
