@@ -42,6 +42,11 @@ TrackingResult FrameTracker::TrackFrom(const TrackingReference& reference, const
   return tracker_.Track(reference, frame, {guess}, affine);
 }
 
+bool FrameTracker::Reacquires(const TrackingResult& result) const {
+  return result.status == TrackingStatus::kOk &&
+         result.stats.good_ratio >= tracker_.Options().suspect_good_ratio;
+}
+
 std::optional<std::pair<std::size_t, TrackingResult>> FrameTracker::Recover(
     const std::vector<RecoveryCandidate>& candidates, const Frame& frame, const Sim3d& S_w_last) {
   for (std::size_t k = 0; k < candidates.size(); ++k) {
@@ -51,10 +56,10 @@ std::optional<std::pair<std::size_t, TrackingResult>> FrameTracker::Recover(
     // and the keyframe's own pose (the camera came back to where it was taken).
     TrackingResult r = tracker_.Track(
         *c.reference, frame, {(c.S_w_kf.Inverse() * S_w_last).RigidPart()}, AffineBrightness{});
-    if (r.status != TrackingStatus::kOk) {
+    if (!Reacquires(r)) {
       r = tracker_.Track(*c.reference, frame, {SE3d()}, AffineBrightness{});
     }
-    if (r.status != TrackingStatus::kOk) continue;
+    if (!Reacquires(r)) continue;
     state_ = MotionState{r.T_kf_frame, SE3d(), r.affine, 1, frame.Timestamp(), 0.0};
     return std::make_pair(k, std::move(r));
   }

@@ -52,9 +52,15 @@ class FrameTracker {
                            const SE3d& guess, const AffineBrightness& affine);
   /// Tries the candidates in order, each from the last pose carried over through the
   /// similarities (S_w_last: the last tracked frame's world similarity) and then from the
-  /// keyframe's own pose; the first that tracks "ok" restarts the motion state on it.
+  /// keyframe's own pose; the first that re-acquires (Reacquires) restarts the motion state
+  /// on it.
   std::optional<std::pair<std::size_t, TrackingResult>> Recover(
       const std::vector<RecoveryCandidate>& candidates, const Frame& frame, const Sim3d& S_w_last);
+
+  /// Whether a result may re-acquire tracking after a loss: "ok" and not suspect (at least
+  /// `suspect_good_ratio` consistent). With no motion to support it, a result that would be
+  /// searched again is not evidence enough (docs/math/tracking.md, "Re-acquisition").
+  bool Reacquires(const TrackingResult& result) const;
 
   /// A new keyframe: pose and velocity restart at identity, no frame tracked in it yet.
   void StartKeyframe();

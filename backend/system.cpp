@@ -286,12 +286,14 @@ TrackingResult System::TrackFrame(const Frame& frame, FrameResult* result) {
     result->events.push_back({SystemEvent::Kind::kDiverged, frame.Id(), current_.id});
   }
   result->tracking_ms = MillisecondsSince(start);
-  if (tracked.status == TrackingStatus::kPoor && previous_frame_lost_ &&
-      start_ == StartState::kInitialised) {
+  if (tracked.status != TrackingStatus::kLost && !tracker_.Reacquires(tracked) &&
+      previous_frame_lost_ && start_ == StartState::kInitialised) {
     // Just below the lost threshold for a run of frames, then just above it, is the same
     // wrong alignment, not a re-acquisition (a 29 degree error was accepted that way).
     tracked.status = TrackingStatus::kLost;
-    tracked.stats.reason = "poor right after a lost frame (re-acquisition needs ok)";
+    tracked.stats.reason =
+        "not confident right after a lost frame (re-acquisition needs ok, "
+        "not suspect)";
     tracker_.SetState(before);
   }
   result->status = tracked.status;

@@ -126,8 +126,9 @@ FrameResult System::ProcessLive(std::int64_t id, double timestamp, const ImageU8
   live_->Follow(snapshot);
   const MotionState before = live_->tracker.State();
   LiveStep step = TrackLive(*frame, snapshot);
-  if (step.tracked.status == TrackingStatus::kPoor && live_->previous_lost) {
-    // As System::TrackFrame: right after a loss only an ok match re-acquires.
+  if (step.tracked.status != TrackingStatus::kLost && !live_->tracker.Reacquires(step.tracked) &&
+      live_->previous_lost) {
+    // As System::TrackFrame: right after a loss only a confident match re-acquires.
     live_->tracker.SetState(before);
     step.tracked.status = TrackingStatus::kLost;
     step.overdue = false;

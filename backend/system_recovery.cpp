@@ -58,7 +58,7 @@ std::optional<std::pair<std::shared_ptr<const Keyframe>, TrackingResult>> System
     } catch (const NumericalDivergence&) {
       continue;  // as a confirmation that failed
     }
-    if (r.status != TrackingStatus::kOk) continue;
+    if (!tracker_.Reacquires(r)) continue;
     ++backend_stats_.relocalisations;
     return std::make_pair(keyframe, std::move(r));
   }

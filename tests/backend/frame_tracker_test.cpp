@@ -74,5 +74,26 @@ TEST_F(FrameTrackerGapTest, FrameRateJitterKeepsTheVelocityAsMeasured) {
   EXPECT_EQ(with.T_kf_frame.Log(), without.T_kf_frame.Log());
 }
 
+// Right after a loss only a confident result re-acquires: ok and at least
+// suspect_good_ratio consistent (on the room patrol, recoveries of 61-66% consistent points
+// after a textureless wall were 25-44 degrees off).
+TEST(FrameTracker, OnlyAConfidentResultReacquires) {
+  const FrameTracker tracker{Se3TrackerOptions{}};
+  TrackingResult result;
+  result.status = TrackingStatus::kOk;
+  result.stats.good_ratio = 0.9;
+  EXPECT_TRUE(tracker.Reacquires(result));
+  result.stats.good_ratio = 0.65;  // ok, but a result the tracker would search again
+  EXPECT_FALSE(tracker.Reacquires(result));
+  result.stats.good_ratio = 0.9;
+  result.status = TrackingStatus::kPoor;
+  EXPECT_FALSE(tracker.Reacquires(result));
+  Se3TrackerOptions trusting;
+  trusting.suspect_good_ratio = 0.0f;
+  result.status = TrackingStatus::kOk;
+  result.stats.good_ratio = 0.65;
+  EXPECT_TRUE(FrameTracker(trusting).Reacquires(result));
+}
+
 }  // namespace
 }  // namespace parallax
