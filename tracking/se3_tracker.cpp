@@ -245,7 +245,7 @@ TrackingResult Se3Tracker::Track(const TrackingReference& reference, const Frame
   std::vector<SE3d> candidates(hypotheses.begin() + 1, hypotheses.end());
   AddRotations(hypotheses.front(), options_.search_rotations_deg, &candidates);
   if (suspect) AddRotations(best.T_kf_frame, options_.search_rotations_deg, &candidates);
-  if (best.status != TrackingStatus::kLost) {
+  if (best.T_kf_frame.Matrix().allFinite()) {
     // A sudden turn: the first run often finds the rotation but lets the translation slide
     // along the rotation-translation ambiguity; restarted from the motion model's
     // translation it converges to the right basin (docs/math/tracking.md, "A sudden turn").

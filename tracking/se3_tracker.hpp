@@ -78,8 +78,8 @@ class Se3Tracker {
 
   /// Tracks `frame` starting from hypotheses[0] (T_kf_frame guesses, at least one). If that
   /// is not kOk, or kOk but suspect (suspect_good_ratio), the remaining hypotheses, small
-  /// rotations around the first (and around a suspect result) and, unless the first result
-  /// is lost, its rotation with the first hypothesis' translation are scored cheaply at the
+  /// rotations around the first (and around a suspect result) and the first result's
+  /// rotation with the first hypothesis' translation are scored cheaply at the
   /// coarsest level and the best is tracked fully; the better result wins (status, then
   /// more consistent points).
   TrackingResult Track(const TrackingReference& reference, const Frame& frame,

@@ -261,6 +261,24 @@ TEST_F(Se3TrackerRenderTest, SuspectOkResultsAreSearchedAgain) {
   EXPECT_EQ(trusting.Track(reference, *frame, start).stats.hypotheses_tried, 1);
 }
 
+// The first run's rotation carries information even when the run is lost: from 9 degrees
+// of pitch off (translation right) the room's first run ends lost, 6.5 degrees off; its
+// rotation with the start's translation converges.
+TEST_F(Se3TrackerRenderTest, TheFirstRunsRotationIsTriedWithTheStartsTranslation) {
+  const TrackingReference reference(keyframe_->frame, keyframe_->idepth, keyframe_->variance);
+  const auto frame = test::RenderTestFrame(*scene_, Pose(14), 1);
+  Eigen::Matrix<double, 6, 1> pitch = Eigen::Matrix<double, 6, 1>::Zero();
+  pitch[3] = 9.0 * 3.14159265358979 / 180.0;
+  const SE3d start = TrueKfFrame(14) * SE3d::Exp(pitch);
+  Se3Tracker tracker;
+  const TrackingResult first = tracker.TrackFrom(reference, *frame, start, {});
+  EXPECT_EQ(first.status, TrackingStatus::kLost);
+  EXPECT_GT(ComparePoses(first.T_kf_frame, TrueKfFrame(14)).rotation_deg, 3.0);
+  const TrackingResult found = tracker.Track(reference, *frame, {start});
+  EXPECT_EQ(found.status, TrackingStatus::kOk) << found.stats.reason;
+  EXPECT_LT(ComparePoses(found.T_kf_frame, TrueKfFrame(14)).rotation_deg, 0.05);
+}
+
 // A camera that starts turning between two frames: the only hypothesis (constant velocity)
 // is 11 degrees of yaw from the truth. Rotations of 1.7 degrees alone (the default) do not
 // reach its basin; the wide search angles do.
