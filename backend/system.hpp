@@ -333,8 +333,8 @@ class System {
   /// Timestamp of the last frame that got a pose (long-loss timer; on a loaded map, of the
   /// first frame given to it).
   double last_posed_timestamp_ = 0.0;
-  /// The previous frame got no pose: a frame tracked only "poor" against the same keyframe
-  /// is then not trusted (re-acquisition needs an ok match, as recovery does).
+  /// The previous frame got no pose: a frame tracked against the same keyframe is then
+  /// trusted only when FrameTracker::Reacquires (as for recovery and relocalisation).
   bool previous_frame_lost_ = false;
   std::unique_ptr<TwoViewBootstrap> bootstrap_;  ///< set while a two-view pair is sought
   int bootstrap_tries_ = 0;

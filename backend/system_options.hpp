@@ -108,7 +108,8 @@ struct SystemOptions {
   double min_update_baseline = 0.004;
   /// When tracking against the current keyframe is lost, the last `recent_keyframes` finished
   /// keyframes are tried (from the pose propagated through the similarities, and from the
-  /// keyframe's own pose); the first that tracks "ok" becomes the current keyframe again.
+  /// keyframe's own pose); the first that re-acquires (FrameTracker::Reacquires) becomes the
+  /// current keyframe again.
   int recent_keyframes = 4;
   /// Frames tracked into a keyframe before it may be replaced ...
   int min_frames_per_keyframe = 3;
