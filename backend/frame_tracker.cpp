@@ -43,8 +43,7 @@ TrackingResult FrameTracker::TrackFrom(const TrackingReference& reference, const
 }
 
 bool FrameTracker::Reacquires(const TrackingResult& result) const {
-  return result.status == TrackingStatus::kOk &&
-         result.stats.good_ratio >= tracker_.Options().suspect_good_ratio;
+  return tracker_.Confident(result);
 }
 
 std::optional<std::pair<std::size_t, TrackingResult>> FrameTracker::Recover(

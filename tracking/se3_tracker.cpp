@@ -232,15 +232,19 @@ TrackingResult Se3Tracker::TrackFrom(const TrackingReference& reference, const F
   return result;
 }
 
+bool Se3Tracker::Confident(const TrackingResult& result) const {
+  return result.status == TrackingStatus::kOk &&
+         result.stats.good_ratio >= options_.suspect_good_ratio;
+}
+
 TrackingResult Se3Tracker::Track(const TrackingReference& reference, const Frame& frame,
                                  const std::vector<SE3d>& hypotheses,
                                  const AffineBrightness& affine_guess) {
   CheckArgument(!hypotheses.empty(), "Se3Tracker::Track: at least one pose hypothesis is needed");
   TrackingResult best = TrackFrom(reference, frame, hypotheses.front(), affine_guess);
   best.stats.hypotheses_tried = 1;
-  const bool suspect =
-      best.status == TrackingStatus::kOk && best.stats.good_ratio < options_.suspect_good_ratio;
-  if (best.status == TrackingStatus::kOk && !suspect) return best;
+  if (Confident(best)) return best;
+  const bool suspect = best.status == TrackingStatus::kOk;  // ok, but not confident
   // Score the alternatives cheaply at the coarsest level.
   std::vector<SE3d> candidates(hypotheses.begin() + 1, hypotheses.end());
   AddRotations(hypotheses.front(), options_.search_rotations_deg, &candidates);

@@ -90,6 +90,11 @@ class Se3Tracker {
   TrackingResult TrackFrom(const TrackingReference& reference, const Frame& frame,
                            const SE3d& T_kf_frame, const AffineBrightness& affine_guess);
 
+  /// "ok" and not suspect: at least `suspect_good_ratio` of the points consistent. Track
+  /// searches on from any other result; a re-acquisition after a loss needs one
+  /// (FrameTracker::Reacquires).
+  bool Confident(const TrackingResult& result) const;
+
   const Se3TrackerOptions& Options() const { return options_; }
 
   /// Normal equations (6 pose + 2 affine parameters, per-point normalised, without prior)
