@@ -75,6 +75,15 @@ double SampsonDistance(const Eigen::Matrix3d& E, const Eigen::Vector2d& x_ref,
   return b.dot(Ea) / std::sqrt(denominator);
 }
 
+double RelativePoseCost(const std::vector<Eigen::Vector2d>& x_ref,
+                        const std::vector<Eigen::Vector2d>& x_cur, const RelativePose& pose,
+                        double focal_px, double huber_px) {
+  CheckArgument(x_ref.size() == x_cur.size() && !x_ref.empty(),
+                "RelativePoseCost: point counts differ or are zero");
+  const Problem problem{x_ref, x_cur, focal_px, huber_px};
+  return problem.Cost(problem.Residuals(pose)) / static_cast<double>(x_ref.size());
+}
+
 RelativePose RefineRelativePose(const std::vector<Eigen::Vector2d>& x_ref,
                                 const std::vector<Eigen::Vector2d>& x_cur,
                                 const RelativePose& initial, double focal_px,

@@ -33,6 +33,13 @@ struct RelativePose {
 double SampsonDistance(const Eigen::Matrix3d& E, const Eigen::Vector2d& x_ref,
                        const Eigen::Vector2d& x_cur);
 
+/// Mean Huber cost (threshold `huber_px`) of the Sampson distances in pixels (normalised
+/// distances times `focal_px`): what RefineRelativePose minimises, per correspondence.
+/// Precondition: x_ref and x_cur of equal, non-zero size.
+double RelativePoseCost(const std::vector<Eigen::Vector2d>& x_ref,
+                        const std::vector<Eigen::Vector2d>& x_cur, const RelativePose& pose,
+                        double focal_px, double huber_px);
+
 /// Refines `initial` by Gauss-Newton with Huber weights on the Sampson distances of the
 /// correspondences (normalised coordinates; `focal_px` converts the Huber threshold). The
 /// rotation is updated on the left (R <- Exp(w) R) and the unit translation on its tangent

@@ -8,6 +8,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "backend/relative_pose_refinement.hpp"
+#include "backend/two_view_ambiguity.hpp"
 #include "core/angles.hpp"
 #include "core/check.hpp"
 
@@ -29,6 +30,10 @@ void TwoViewBootstrapOptions::Check() const {
   CheckOption(min_inliers >= 8, "TwoViewBootstrapOptions", "min_inliers", "must be >= 8");
   CheckOption(min_parallax_deg > 0.0, "TwoViewBootstrapOptions", "min_parallax_deg", "must be > 0");
   CheckOption(parallax_points >= 1, "TwoViewBootstrapOptions", "parallax_points", "must be >= 1");
+  CheckOption(max_homography_share > 0.0 && max_homography_share <= 1.0, "TwoViewBootstrapOptions",
+              "max_homography_share", "must be in (0, 1]");
+  CheckOption(min_twin_cost_ratio >= 0.0, "TwoViewBootstrapOptions", "min_twin_cost_ratio",
+              "must be >= 0");
 }
 
 TwoViewBootstrap::TwoViewBootstrap(const PinholeCamera& camera,
@@ -168,6 +173,15 @@ void RefineMatchesByKlt(const ImageU8& ref, const ImageU8& cur, Matches* matches
   *matches = std::move(kept);
 }
 
+PixelCorrespondences Inlying(const Matches& matches, const std::vector<std::size_t>& inliers) {
+  PixelCorrespondences c;
+  for (const std::size_t i : inliers) {
+    c.ref.emplace_back(matches.ref[i].x, matches.ref[i].y);
+    c.cur.emplace_back(matches.cur[i].x, matches.cur[i].y);
+  }
+  return c;
+}
+
 /// The RANSAC model is a 5-point solution; every cheirality-checked inlier refines it.
 RelativePose PolishOnInliers(const PinholeCamera& camera, const Matches& matches,
                              const std::vector<std::size_t>& inliers, const RelativePose& pose) {
@@ -182,6 +196,22 @@ RelativePose PolishOnInliers(const PinholeCamera& camera, const Matches& matches
     cur.push_back(normalised(matches.cur[i]));
   }
   return RefineRelativePose(ref, cur, pose, 0.5 * (camera.Fx() + camera.Fy()));
+}
+
+/// False when the pair's inliers do not determine its motion (docs/math/two_view.md,
+/// "Ambiguous pairs"): a homography explains too many of them, or another motion explains
+/// them almost as well.
+bool Determined(const PinholeCamera& camera, const TwoViewBootstrapOptions& options,
+                const PixelCorrespondences& inliers, const RelativePose& pose) {
+  if (options.max_homography_share >= 1.0 && options.min_twin_cost_ratio <= 0.0) return true;
+  const auto H = FitHomography(inliers, options.ransac_threshold_px);
+  if (!H) return true;  // no homography explains them
+  if (HomographyShare(*H, inliers, options.ransac_threshold_px) > options.max_homography_share) {
+    return false;
+  }
+  if (options.min_twin_cost_ratio <= 0.0) return true;
+  const std::optional<double> twin = TwinCostRatio(camera, *H, inliers, pose);
+  return !twin || *twin >= options.min_twin_cost_ratio;
 }
 
 }  // namespace
@@ -217,6 +247,9 @@ std::optional<TwoViewPair> TwoViewBootstrap::TryFrame(const ImageU8& image) {
   if (pair.parallax_deg < options.min_parallax_deg) return std::nullopt;
   const RelativePose refined =
       PolishOnInliers(impl_->camera, matches, tri.match_index, {SO3d(R_e), t_e.normalized()});
+  if (!Determined(impl_->camera, options, Inlying(matches, tri.match_index), refined)) {
+    return std::nullopt;
+  }
   // |t| = 1 in recoverPose's units; scale so the median reference depth becomes 1.
   const double median_depth = KthLargest(tri.depths, static_cast<int>(tri.depths.size() / 2) + 1);
   pair.T_frame_ref = SE3d(refined.R_cur_ref, refined.t_cur_ref / median_depth);

@@ -20,6 +20,16 @@ struct TwoViewBootstrapOptions {
   double min_parallax_deg = 2.0;
   int parallax_points = 50;
   double ransac_threshold_px = 1.0;
+  /// A pair is refused while a homography explains more than this share of its inliers
+  /// (transfer error under `ransac_threshold_px`): the views then do not determine the
+  /// geometry (too little parallax for the scene's relief, or a plane), and the essential
+  /// matrix may be a plane's twin solution (docs/math/two_view.md, "Homography gate").
+  /// 1: no gate.
+  double max_homography_share = 0.9;
+  /// A pair is refused while another motion that the inliers' homography allows, polished on
+  /// them as the pair's pose is, explains them at less than this multiple of the pair's robust
+  /// cost (the essential matrix has found one of two near-equal solutions). 0: no test.
+  double min_twin_cost_ratio = 1.25;
 
   void Check() const;
 };

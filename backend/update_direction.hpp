@@ -52,8 +52,12 @@ struct UpdateDirectionOptions {
   /// ... and while the frame has turned at most this much from the checked one, degrees (in
   /// a turn, where the tracked yaw and direction go wrong together, every update is checked).
   double reuse_max_rotation_deg = 1.0;
-  TwoViewBootstrapOptions matcher{
-      .max_features = 800, .min_inliers = 100, .min_parallax_deg = 0.5, .parallax_points = 30};
+  TwoViewBootstrapOptions matcher{.max_features = 800,
+                                  .min_inliers = 100,
+                                  .min_parallax_deg = 0.5,
+                                  .parallax_points = 30,
+                                  .max_homography_share = 1.0,
+                                  .min_twin_cost_ratio = 0.0};
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;

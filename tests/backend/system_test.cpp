@@ -316,10 +316,13 @@ TEST(Pipeline, SharedTumClip) {
   const EvaluationReport r = Evaluate(ReadTumTrajectory(run.out_dir + "/trajectory.txt"),
                                       ReadTumTrajectory(run.dataset + "/groundtruth.txt"), {});
   RecordProperty("ate_m", std::to_string(r.ate.rmse));
-  // Measured 37/37 frames and 5.9 mm; the bound leaves room for platform differences in
-  // float rounding while staying at the issue's 1 cm goal.
+  // Measured 37/37 frames and 5.1 mm (5.955 mm before the two-view start's homography gate);
+  // the bound is issue 13's.
   EXPECT_EQ(s.frames_tracked, 37);
-  EXPECT_LT(r.ate.rmse, 0.01);
+  EXPECT_LT(r.ate.rmse, 0.0059);
+  // The orientation, which the ATE of positions does not see: measured 1.0 degree rms over
+  // 1 s steps (13 degrees when the start took the plane's twin solution of its pair).
+  EXPECT_LT(r.rpe_per_second.rotation_deg.rmse, 3.0);
   // The camera moves from the first frame on: the start must complete within its first
   // second (30 frames; measured: frame 20).
   EXPECT_GE(s.initialised_at_frame, 0);

@@ -61,6 +61,26 @@ TEST_F(TwoViewBootstrapTest, RejectsPairsWithoutParallax) {
   EXPECT_FALSE(bootstrap.TryFrame(RenderImage(Moved(step), 1.0f, 1.0)).has_value());
 }
 
+TEST_F(TwoViewBootstrapTest, RefusesAPairAHomographyExplains) {
+  // A 2 cm step in the room: with the parallax bar lowered, the essential matrix is found,
+  // but the relief moves the points by less than the RANSAC threshold from where a
+  // homography puts them, so the views do not determine the motion (on the TUM clip such a
+  // pair was a twin solution 5 degrees off). The gate refuses it; ungated it is accepted.
+  TwoViewBootstrapOptions options;
+  options.min_parallax_deg = 0.2;
+  const SE3d step(SO3d::Exp(Eigen::Vector3d(0.0, 1.0 / kDegPerRad, 0.0)),
+                  Eigen::Vector3d(0.02, 0.0, 0.0));
+  const ImageU8 ref = RenderImage(T_w_ref_, 1.0f, 1.0);
+  const ImageU8 moved = RenderImage(Moved(step), 1.0f, 1.0);
+  TwoViewBootstrap gated(camera_, options);
+  gated.SetReference(ref);
+  EXPECT_FALSE(gated.TryFrame(moved).has_value());
+  options.max_homography_share = 1.0;
+  TwoViewBootstrap ungated(camera_, options);
+  ungated.SetReference(ref);
+  EXPECT_TRUE(ungated.TryFrame(moved).has_value());
+}
+
 TEST_F(TwoViewBootstrapTest, RejectsATexturelessFrame) {
   TwoViewBootstrap bootstrap(camera_);
   bootstrap.SetReference(RenderImage(T_w_ref_, 1.0f, 1.0));
@@ -73,6 +93,11 @@ TEST(TwoViewBootstrapOptions, CheckRejectsBadValues) {
   EXPECT_THROW(options.Check(), std::invalid_argument);
   options = {};
   options.min_parallax_deg = 0.0;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+  options = {};
+  options.max_homography_share = 0.0;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+  options.max_homography_share = 1.01;
   EXPECT_THROW(options.Check(), std::invalid_argument);
 }
 
