@@ -23,7 +23,7 @@ struct TwoViewBootstrapOptions {
   /// A pair is refused while a homography explains more than this share of its inliers
   /// (transfer error under `ransac_threshold_px`): the views then do not determine the
   /// geometry (too little parallax for the scene's relief, or a plane), and the essential
-  /// matrix may be a plane's twin solution (docs/math/two_view.md, "Homography gate").
+  /// matrix may be a plane's twin solution (docs/math/two_view.md, "Ambiguous pairs").
   /// 1: no gate.
   double max_homography_share = 0.9;
   /// A pair is refused while another motion that the inliers' homography allows, polished on

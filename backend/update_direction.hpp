@@ -52,6 +52,8 @@ struct UpdateDirectionOptions {
   /// ... and while the frame has turned at most this much from the checked one, degrees (in
   /// a turn, where the tracked yaw and direction go wrong together, every update is checked).
   double reuse_max_rotation_deg = 1.0;
+  /// The start's ambiguity tests are off here: each check is blended in only after agreeing
+  /// with the tracked pose within max_angle_deg, which a twin solution does not.
   TwoViewBootstrapOptions matcher{.max_features = 800,
                                   .min_inliers = 100,
                                   .min_parallax_deg = 0.5,
