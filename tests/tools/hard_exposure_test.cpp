@@ -29,11 +29,21 @@ std::string SharedClip(const std::string& name) {
   return std::string(PARALLAX_SHARED_DATA_DIR) + "/" + name;
 }
 
-// Gain of frame k of n: the first `dark` frames rise from 3% exposure by 40% a frame, the last
-// `bright` frames rise by 35% a frame from 1.35x (clipped at 255).
-double Gain(int k, int n, int dark, int bright) {
-  if (k < dark) return 0.03 * std::pow(1.4, k);
-  if (k >= n - bright) return std::pow(1.35, k - (n - bright) + 1);
+// Exposure ramps: the first `dark` frames rise from `dark_start` by `dark_rate` a frame, the
+// last `bright` frames from `bright_start` by `bright_rate` a frame (clipped at 255).
+struct Ramps {
+  int dark = 10;
+  int bright = 8;
+  double dark_start = 0.03, dark_rate = 1.4;
+  double bright_start = 1.35, bright_rate = 1.35;
+};
+
+// Gain of frame k of n.
+double Gain(int k, int n, const Ramps& ramps) {
+  if (k < ramps.dark) return ramps.dark_start * std::pow(ramps.dark_rate, k);
+  if (k >= n - ramps.bright) {
+    return ramps.bright_start * std::pow(ramps.bright_rate, k - (n - ramps.bright));
+  }
   return 1.0;
 }
 
@@ -76,7 +86,7 @@ struct ExposedFrame {
 
 // A copy of the clip with exposure applied to the images (sensor noise sigma 1.5 added).
 std::vector<ExposedFrame> WriteExposedCopy(const std::string& clip, const std::string& out,
-                                           int dark, int bright) {
+                                           const Ramps& ramps) {
   std::filesystem::copy(clip, out, std::filesystem::copy_options::recursive);
   const std::vector<ClipImage> images = ClipImages(clip);
   std::vector<ExposedFrame> exposed;
@@ -86,7 +96,7 @@ std::vector<ExposedFrame> WriteExposedCopy(const std::string& clip, const std::s
   for (int k = 0; k < n; ++k) {
     const ClipImage& source = images[static_cast<std::size_t>(k)];
     cv::Mat image = ReadImageFile(clip + "/" + source.file, ImageReadMode::kGrey8);
-    const double gain = Gain(k, n, dark, bright);
+    const double gain = Gain(k, n, ramps);
     for (int y = 0; y < image.rows; ++y) {
       for (int x = 0; x < image.cols; ++x) {
         const double v = gain * image.at<std::uint8_t>(y, x) + noise(rng);
@@ -107,9 +117,9 @@ struct HardRun {
 };
 
 // Runs the exposed copy of `clip` (written as `name`, which tells the camera) and measures it.
-HardRun RunExposed(const std::string& clip, const std::string& name, int dark, int bright) {
+HardRun RunExposed(const std::string& clip, const std::string& name, const Ramps& ramps) {
   const test::TempDir dir;
-  const auto frames = WriteExposedCopy(clip, dir.File(name), dark, bright);
+  const auto frames = WriteExposedCopy(clip, dir.File(name), ramps);
   RunOptions run;
   run.dataset = dir.File(name);
   run.out_dir = dir.File("out");
@@ -133,7 +143,7 @@ HardRun RunExposed(const std::string& clip, const std::string& name, int dark, i
 
 TEST(HardExposure, DarkStartAndBlownOutEndArePosedRightOrNotAtAll) {
   const HardRun r = RunExposed(SharedClip("rgbd_dataset_freiburg1_xyz_first37"),
-                               "rgbd_dataset_freiburg1_xyz", 10, 8);
+                               "rgbd_dataset_freiburg1_xyz", Ramps{});
   RecordProperty("share_posed", std::to_string(r.share_posed));
   RecordProperty("worst_error_percent_of_path", std::to_string(r.worst_percent));
   // Measured: 20 of 37 posed (frames 10-29: the start restarts twice while the exposure
@@ -145,10 +155,24 @@ TEST(HardExposure, DarkStartAndBlownOutEndArePosedRightOrNotAtAll) {
   EXPECT_TRUE(r.posed_without_light.empty()) << "first: frame " << r.posed_without_light[0];
 }
 
+// Other ramps on the TUM clip, measured when the defaults were already chosen (a held-out
+// variant): 9 dark frames from 3% rising 45% a frame, 7 bright from 1.4x rising 40%.
+TEST(HardExposure, AnotherDarkStartAndBlownOutEndIsPosedWithinThreePercent) {
+  const HardRun r = RunExposed(SharedClip("rgbd_dataset_freiburg1_xyz_first37"),
+                               "rgbd_dataset_freiburg1_xyz", Ramps{9, 7, 0.03, 1.45, 1.4, 1.4});
+  RecordProperty("share_posed", std::to_string(r.share_posed));
+  RecordProperty("worst_error_percent_of_path", std::to_string(r.worst_percent));
+  // Measured: 22 of 37 posed, worst 2.1% of the matched path (4.8% when the start could take
+  // an ambiguous two-view pair, docs/math/two_view.md "Ambiguous pairs").
+  EXPECT_GE(r.share_posed, 0.4);
+  EXPECT_LE(r.worst_percent, 3.0);
+  EXPECT_TRUE(r.posed_without_light.empty()) << "first: frame " << r.posed_without_light[0];
+}
+
 // The same exposure ramps on the KITTI clip (160 frames, about 90 m driven).
 TEST(HardExposure, DrivingClipWithDarkStartAndBlownOutEndIsPosedWithinThreePercent) {
   const HardRun r =
-      RunExposed(SharedClip("kitti_odometry_07_first160"), "kitti_odometry_07_first160", 10, 8);
+      RunExposed(SharedClip("kitti_odometry_07_first160"), "kitti_odometry_07_first160", Ramps{});
   RecordProperty("share_posed", std::to_string(r.share_posed));
   RecordProperty("worst_error_percent_of_path", std::to_string(r.worst_percent));
   EXPECT_GE(r.share_posed, 0.4);
