@@ -17,27 +17,25 @@ std::vector<cv::Point2d> ToCv(const std::vector<Eigen::Vector2d>& points) {
   return out;
 }
 
-std::vector<Eigen::Vector2d> Normalised(const PinholeCamera& camera,
-                                        const std::vector<Eigen::Vector2d>& pixels) {
-  std::vector<Eigen::Vector2d> out;
-  out.reserve(pixels.size());
-  for (const Eigen::Vector2d& p : pixels) {
-    out.emplace_back((p.x() - camera.Cx()) / camera.Fx(), (p.y() - camera.Cy()) / camera.Fy());
-  }
-  return out;
-}
-
 double RotationGapDeg(const SO3d& a, const SO3d& b) {
   return (a.Inverse() * b).Log().norm() * kRadToDeg;
 }
 
 /// Angle between two translation directions, sign ignored (the Sampson cost does not see it).
 double DirectionGapDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  const double c = std::abs(a.normalized().dot(b.normalized()));
-  return std::acos(std::min(1.0, c)) * kRadToDeg;
+  const double angle = AngleBetweenDeg(a, b);
+  return std::min(angle, 180.0 - angle);
 }
 
 }  // namespace
+
+std::vector<Eigen::Vector2d> Normalised(const PinholeCamera& camera,
+                                        const std::vector<Eigen::Vector2d>& pixels) {
+  std::vector<Eigen::Vector2d> out;
+  out.reserve(pixels.size());
+  for (const Eigen::Vector2d& p : pixels) out.push_back(camera.Unproject(p).head<2>());
+  return out;
+}
 
 std::optional<Eigen::Matrix3d> FitHomography(const PixelCorrespondences& c, double threshold_px) {
   if (c.ref.size() < 4 || c.ref.size() != c.cur.size()) return std::nullopt;

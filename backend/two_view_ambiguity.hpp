@@ -16,6 +16,10 @@ struct PixelCorrespondences {
   std::vector<Eigen::Vector2d> ref, cur;
 };
 
+/// The pixels in normalised coordinates (the ray at z = 1, PinholeCamera::Unproject).
+std::vector<Eigen::Vector2d> Normalised(const PinholeCamera& camera,
+                                        const std::vector<Eigen::Vector2d>& pixels);
+
 /// Reference-to-frame homography fitted by RANSAC (`threshold_px`); nullopt when fewer than
 /// 4 correspondences or the fit fails.
 std::optional<Eigen::Matrix3d> FitHomography(const PixelCorrespondences& c, double threshold_px);

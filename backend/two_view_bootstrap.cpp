@@ -183,19 +183,10 @@ PixelCorrespondences Inlying(const Matches& matches, const std::vector<std::size
 }
 
 /// The RANSAC model is a 5-point solution; every cheirality-checked inlier refines it.
-RelativePose PolishOnInliers(const PinholeCamera& camera, const Matches& matches,
-                             const std::vector<std::size_t>& inliers, const RelativePose& pose) {
-  std::vector<Eigen::Vector2d> ref, cur;
-  ref.reserve(inliers.size());
-  cur.reserve(inliers.size());
-  const auto normalised = [&](const cv::Point2d& p) {
-    return Eigen::Vector2d((p.x - camera.Cx()) / camera.Fx(), (p.y - camera.Cy()) / camera.Fy());
-  };
-  for (const std::size_t i : inliers) {
-    ref.push_back(normalised(matches.ref[i]));
-    cur.push_back(normalised(matches.cur[i]));
-  }
-  return RefineRelativePose(ref, cur, pose, 0.5 * (camera.Fx() + camera.Fy()));
+RelativePose PolishOnInliers(const PinholeCamera& camera, const PixelCorrespondences& inliers,
+                             const RelativePose& pose) {
+  return RefineRelativePose(Normalised(camera, inliers.ref), Normalised(camera, inliers.cur), pose,
+                            0.5 * (camera.Fx() + camera.Fy()));
 }
 
 /// False when the pair's inliers do not determine its motion (docs/math/two_view.md,
@@ -245,9 +236,10 @@ std::optional<TwoViewPair> TwoViewBootstrap::TryFrame(const ImageU8& image) {
   TwoViewPair pair;
   pair.parallax_deg = KthLargest(tri.angles_deg, options.parallax_points);
   if (pair.parallax_deg < options.min_parallax_deg) return std::nullopt;
+  const PixelCorrespondences inliers = Inlying(matches, tri.match_index);
   const RelativePose refined =
-      PolishOnInliers(impl_->camera, matches, tri.match_index, {SO3d(R_e), t_e.normalized()});
-  if (!Determined(impl_->camera, options, Inlying(matches, tri.match_index), refined)) {
+      PolishOnInliers(impl_->camera, inliers, {SO3d(R_e), t_e.normalized()});
+  if (!Determined(impl_->camera, options, inliers, refined)) {
     return std::nullopt;
   }
   // |t| = 1 in recoverPose's units; scale so the median reference depth becomes 1.
