@@ -42,6 +42,11 @@ TrackingResult FrameTracker::TrackFrom(const TrackingReference& reference, const
   return tracker_.Track(reference, frame, {guess}, affine);
 }
 
+TrackingResult FrameTracker::Retrack(const TrackingReference& reference, const Frame& frame,
+                                     const SE3d& guess, const AffineBrightness& affine) {
+  return tracker_.Refine(reference, frame, guess, affine);
+}
+
 bool FrameTracker::Reacquires(const TrackingResult& result) const {
   return tracker_.Confident(result);
 }

@@ -50,6 +50,10 @@ class FrameTracker {
   /// One start, no state change (frames tracked again during initialisation).
   TrackingResult TrackFrom(const TrackingReference& reference, const Frame& frame,
                            const SE3d& guess, const AffineBrightness& affine);
+  /// A frame tracked before, again on a refined map from its pose then (Se3Tracker::Refine);
+  /// no state change.
+  TrackingResult Retrack(const TrackingReference& reference, const Frame& frame, const SE3d& guess,
+                         const AffineBrightness& affine);
   /// Tries the candidates in order, each from the last pose carried over through the
   /// similarities (S_w_last: the last tracked frame's world similarity) and then from the
   /// keyframe's own pose; the first that re-acquires (Reacquires) restarts the motion state

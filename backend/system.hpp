@@ -260,6 +260,8 @@ class System {
                                                       const ImageU8& image,
                                                       const TrackingResult& tracked);
   bool RandomStartAgrees(const SE3d& T_kf_frame, const TwoViewPair& pair) const;
+  /// A frame posed before, tracked again on the current (refined) map from that pose
+  /// (FrameTracker::Retrack); nullopt when lost.
   std::optional<SE3d> TrackAgain(const Frame& frame, const SE3d& guess);
   void BufferInitialFrame(const std::shared_ptr<const Frame>& frame, const SE3d& T_kf_frame);
   /// Replaces the first keyframe's depth by stereo with the pair's frame (in initial_frames_)

@@ -73,7 +73,7 @@ void System::BufferInitialFrame(const std::shared_ptr<const Frame>& frame, const
 
 std::optional<SE3d> System::TrackAgain(const Frame& frame, const SE3d& guess) {
   const TrackingResult again =
-      tracker_.TrackFrom(*mapper_.Reference(), frame, guess, tracker_.State().affine);
+      tracker_.Retrack(*mapper_.Reference(), frame, guess, tracker_.State().affine);
   if (again.status == TrackingStatus::kLost) return std::nullopt;
   return again.T_kf_frame;
 }
@@ -90,8 +90,11 @@ std::vector<RevisedPose> System::FinishInitialisation() {
     for (const auto& [frame, T_kf_frame] : initial_frames_) {
       if (frame == pair_frame) guess = T_kf_frame;
     }
-    const auto T_kf_pair_frame = TrackAgain(*pair_frame, guess);
-    if (!T_kf_pair_frame || !RandomStartAgrees(*T_kf_pair_frame, pair)) {
+    // One coarse-to-fine run (not Retrack): the random start's own answer is what is judged.
+    const TrackingResult pair_again =
+        tracker_.TrackFrom(*mapper_.Reference(), *pair_frame, guess, tracker_.State().affine);
+    if (pair_again.status == TrackingStatus::kLost ||
+        !RandomStartAgrees(pair_again.T_kf_frame, pair)) {
       revised = StartFromPair(pair_frame, pair);
       replaced = true;
     } else {

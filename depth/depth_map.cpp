@@ -26,6 +26,8 @@ void DepthFilterOptions::Check() const {
   CheckOption(max_search_length >= 3.0f, s, "max_search_length", "must be >= 3");
   CheckOption(max_search_length_new >= 3.0f, s, "max_search_length_new", "must be >= 3");
   CheckOption(baseline_sigma >= 0.0f, s, "baseline_sigma", "must be >= 0");
+  CheckOption(rotation_sigma >= 0.0f && rotation_sigma <= 1.0f, s, "rotation_sigma",
+              "must be in [0, 1]");
   CheckOption(min_search_length >= 2.0f && min_search_length <= max_search_length, s,
               "min_search_length", "must be in [2, max_search_length]");
   CheckOption(min_rescale > 0.0f && max_rescale > min_rescale, s, "min_rescale/max_rescale",

@@ -47,6 +47,11 @@ struct DepthFilterOptions {
   /// normalisation): adds (idepth * baseline_sigma / |t|)^2 to an observation's variance, so
   /// tiny baselines, whose pose error is a large share of the baseline, count for little.
   float baseline_sigma = 0.001f;
+  /// Relative uncertainty of the tracked rotation keyframe -> frame: a rotation is known to
+  /// this share of itself, which moves a match by the same share of the rotation's image
+  /// motion; its component along the epipolar line enters the disparity variance
+  /// (docs/math/depth_filter.md, "Error model").
+  float rotation_sigma = 0.0f;
   /// Allowed change of the apparent pattern scale between keyframe and frame.
   float min_rescale = 0.7f;
   float max_rescale = 1.4f;

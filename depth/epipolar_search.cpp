@@ -211,10 +211,16 @@ StereoObservation EpipolarSearch::Observe(int x, int y, float min_idepth, float 
   const float photometric =
       2.0f * options_.pixel_noise_sigma * options_.pixel_noise_sigma / std::max(g_frame_sq, 1.0f);
   const float baseline_relative = options_.baseline_sigma / std::max(t_.norm(), 1e-9f);
+  // A rotation known to rotation_sigma of itself moves the match by that share of the
+  // rotation's image motion (where a point at infinity goes); along the line it is disparity.
+  const Eigen::Vector2f rotation_flow(fx_ * Rq.x() / Rq.z() + cx_ - static_cast<float>(x),
+                                      fy_ * Rq.y() / Rq.z() + cy_ - static_cast<float>(y));
+  const float rotation_along = options_.rotation_sigma * rotation_flow.dot(dir);
   out.status = StereoStatus::kOk;
   out.idepth = d;
-  out.variance = alpha * alpha * (geometric + photometric + 0.05f) +
-                 d * d * baseline_relative * baseline_relative;
+  out.variance =
+      alpha * alpha * (geometric + photometric + 0.05f + rotation_along * rotation_along) +
+      d * d * baseline_relative * baseline_relative;
   return out;
 }
 

@@ -90,6 +90,8 @@ void Se3TrackerOptions::Check() const {
   }
   CheckOption(velocity_rescale_ratio > 1.0 && std::isfinite(velocity_rescale_ratio), s,
               "velocity_rescale_ratio", "must be finite and > 1");
+  CheckOption(refine_margin >= 0.0 && refine_margin <= 1.0, s, "refine_margin",
+              "must be in [0, 1]");
 }
 
 Se3Tracker::Se3Tracker(const Se3TrackerOptions& options) : options_(options) { options_.Check(); }
@@ -230,6 +232,27 @@ TrackingResult Se3Tracker::TrackFrom(const TrackingReference& reference, const F
   TrackingResult result = Finish(reference, state, finest_evaluation);
   result.stats.iterations = iterations;
   return result;
+}
+
+TrackingResult Se3Tracker::Refine(const TrackingReference& reference, const Frame& frame,
+                                  const SE3d& T_kf_frame, const AffineBrightness& affine_guess) {
+  TrackingResult tracked = Track(reference, frame, {T_kf_frame}, affine_guess);
+  State state{T_kf_frame.Inverse(), options_.estimate_affine ? affine_guess : AffineBrightness{}};
+  const AffineBrightness prior = state.affine;
+  const int finest = std::min(options_.finest_level, reference.NumLevels() - 1);
+  LevelEvaluation evaluation;
+  const int iterations = OptimizeLevel(reference, frame, finest,
+                                       MaxIterationsForLevel(options_.max_iterations, finest),
+                                       prior, &state, &evaluation);
+  TrackingResult local = Finish(reference, state, evaluation);
+  local.stats.iterations[static_cast<std::size_t>(finest)] = iterations;
+  local.stats.hypotheses_tried = tracked.stats.hypotheses_tried + 1;
+  // Two results of one basin differ by a few points either way; only a clear gain is another.
+  const double margin = options_.refine_margin * tracked.stats.points_in_view;
+  const bool better = local.status < tracked.status ||
+                      (local.status == tracked.status &&
+                       local.stats.points_good > tracked.stats.points_good + margin);
+  return better ? local : tracked;
 }
 
 bool Se3Tracker::Confident(const TrackingResult& result) const {

@@ -63,6 +63,10 @@ struct Se3TrackerOptions {
   /// skipped or lost. Within it (frame-rate jitter; TUM's 32/36 ms) the velocity is used as it
   /// is. Must be > 1.
   double velocity_rescale_ratio = 1.5;
+  /// Refine: the pose refined on the finest level alone replaces the coarse-to-fine result
+  /// only with more consistent points by this share of the points in view (results in one
+  /// basin differ by well under 1%; the stray re-track that motivated Refine, by 16%).
+  double refine_margin = 0.05;
 
   void Check() const;
 };
@@ -89,6 +93,15 @@ class Se3Tracker {
   /// Single coarse-to-fine run from one guess over levels [finest, coarsest].
   TrackingResult TrackFrom(const TrackingReference& reference, const Frame& frame,
                            const SE3d& T_kf_frame, const AffineBrightness& affine_guess);
+
+  /// Tracks again a frame whose pose T_kf_frame is already close (the map it was tracked on
+  /// has been refined since): Track from it, and the guess refined on the finest tracked
+  /// level alone; the better of the two wins (status, then clearly more consistent points:
+  /// refine_margin). The
+  /// coarse levels can pull a converged pose into another basin (docs/math/tracking.md,
+  /// "Tracking a frame again").
+  TrackingResult Refine(const TrackingReference& reference, const Frame& frame,
+                        const SE3d& T_kf_frame, const AffineBrightness& affine_guess);
 
   /// "ok" and not suspect: at least `suspect_good_ratio` of the points consistent. Track
   /// searches on from any other result; a re-acquisition after a loss needs one

@@ -203,5 +203,77 @@ TEST_F(EpipolarSearchTest, BaselineUncertaintyAddsToTheVariance) {
   EXPECT_GT(compared, 500);
 }
 
+// An uncertain rotation enters as alpha^2 (rotation_sigma * f . l)^2, f being the rotation's
+// image motion at the pixel (where a point at infinity goes) and l the epipolar direction: the
+// same match, with a variance that grows with the rotation (zero for a pure translation).
+// alpha and f are computed here from the geometry.
+TEST_F(EpipolarSearchTest, RotationUncertaintyAddsToTheVariance) {
+  const SE3d T_kf_frame(SO3d::Exp(Eigen::Vector3d(0.01, 0.04, 0.0)),
+                        Eigen::Vector3d(0.02, 0.0, 0.05));
+  const auto frame = test::RenderTestFrame(*scene_, T_w_kf_ * T_kf_frame, 1);
+  DepthFilterOptions without;
+  without.rotation_sigma = 0.0f;
+  DepthFilterOptions with;
+  with.rotation_sigma = 0.02f;
+  const StereoFrame stereo{frame.get(), T_kf_frame.Inverse()};
+  const EpipolarSearch a(*keyframe_->frame, stereo, without), b(*keyframe_->frame, stereo, with);
+  const PinholeCamera& camera = keyframe_->frame->Camera(0);
+  const Eigen::Matrix3d R = stereo.T_frame_kf.RotationMatrix();
+  const Eigen::Vector3d t = stereo.T_frame_kf.Translation();
+  int compared = 0;
+  int within_2_percent = 0;
+  double largest_extra = 0.0;  // relative to the variance without
+  const ImageF& truth = keyframe_->idepth;
+  for (int y = 20; y < truth.Height() - 20; y += 7) {
+    for (int x = 20; x < truth.Width() - 20; x += 7) {
+      const float d = truth(x, y);
+      if (!(d > 0.0f)) continue;
+      const StereoObservation oa = a.Observe(x, y, 0.9f * d, 1.1f * d, d, 30.0f);
+      const StereoObservation ob = b.Observe(x, y, 0.9f * d, 1.1f * d, d, 30.0f);
+      ASSERT_EQ(oa.status, ob.status);
+      if (oa.status != StereoStatus::kOk) continue;
+      ++compared;
+      EXPECT_EQ(oa.idepth, ob.idepth);
+      const Eigen::Vector2d u(x, y);
+      const Eigen::Vector3d Rq = R * camera.Unproject(u);
+      const auto project = [&](double idepth) { return camera.Project(Rq + idepth * t); };
+      const Eigen::Vector2d dir = (project(1.1 * d) - project(0.9 * d)).normalized();
+      const double h = 1e-4 * oa.idepth;
+      const double alpha = 2.0 * h / (project(oa.idepth + h) - project(oa.idepth - h)).norm();
+      const double along = 0.02 * (project(0.0) - u).dot(dir);
+      const double extra = alpha * alpha * along * along;
+      // alpha here is a derivative, the search's a difference over a pixel: equal to 2% but
+      // near the epipole, where the inverse depth along the line curves.
+      EXPECT_NEAR(ob.variance - oa.variance, extra, 0.1 * extra + 1e-12);
+      if (std::abs(ob.variance - oa.variance - extra) <= 0.02 * extra + 1e-12) ++within_2_percent;
+      largest_extra = std::max(largest_extra, extra / oa.variance);
+    }
+  }
+  EXPECT_GT(compared, 500);
+  EXPECT_GE(within_2_percent, compared * 99 / 100);
+  EXPECT_GT(largest_extra, 0.1);  // the term matters: about 20 px of image motion
+
+  // A pure translation moves nothing at infinity: the variance is unchanged.
+  const Eigen::Vector3d shift(0.02, 0.0, 0.05);
+  const auto translated = FrameAt(shift);
+  const StereoFrame straight{translated.get(), SE3d(SO3d(), shift).Inverse()};
+  const EpipolarSearch c(*keyframe_->frame, straight, without),
+      e(*keyframe_->frame, straight, with);
+  int unchanged = 0;
+  for (int y = 20; y < truth.Height() - 20; y += 7) {
+    for (int x = 20; x < truth.Width() - 20; x += 7) {
+      const float d = truth(x, y);
+      if (!(d > 0.0f)) continue;
+      const StereoObservation oc = c.Observe(x, y, 0.9f * d, 1.1f * d, d, 30.0f);
+      const StereoObservation oe = e.Observe(x, y, 0.9f * d, 1.1f * d, d, 30.0f);
+      if (oc.status != StereoStatus::kOk) continue;
+      ASSERT_EQ(oe.status, StereoStatus::kOk);
+      EXPECT_EQ(oc.variance, oe.variance);
+      ++unchanged;
+    }
+  }
+  EXPECT_GT(unchanged, 500);
+}
+
 }  // namespace
 }  // namespace parallax
