@@ -48,7 +48,8 @@ TrackingResult FrameTracker::Retrack(const TrackingReference& reference, const F
 }
 
 bool FrameTracker::Reacquires(const TrackingResult& result) const {
-  return tracker_.Confident(result);
+  return tracker_.Confident(result) &&
+         result.stats.points_good >= tracker_.Options().min_reacquisition_points;
 }
 
 std::optional<std::pair<std::size_t, TrackingResult>> FrameTracker::Recover(

@@ -62,8 +62,10 @@ class FrameTracker {
       const std::vector<RecoveryCandidate>& candidates, const Frame& frame, const Sim3d& S_w_last);
 
   /// Whether a result may re-acquire tracking after a loss: "ok" and not suspect (at least
-  /// `suspect_good_ratio` consistent). With no motion to support it, a result that would be
-  /// searched again is not evidence enough (docs/math/tracking.md, "Re-acquisition").
+  /// `suspect_good_ratio` consistent), with at least `min_reacquisition_points` consistent
+  /// points. With no motion to support it, a result that would be searched again, or a few
+  /// hundred points of a weakly textured view, is not evidence enough (docs/math/tracking.md,
+  /// "Re-acquisition").
   bool Reacquires(const TrackingResult& result) const;
 
   /// A new keyframe: pose and velocity restart at identity, no frame tracked in it yet.

@@ -92,6 +92,7 @@ void Se3TrackerOptions::Check() const {
               "velocity_rescale_ratio", "must be finite and > 1");
   CheckOption(refine_margin >= 0.0 && refine_margin <= 1.0, s, "refine_margin",
               "must be in [0, 1]");
+  CheckOption(min_reacquisition_points >= 0, s, "min_reacquisition_points", "must be >= 0");
 }
 
 Se3Tracker::Se3Tracker(const Se3TrackerOptions& options) : options_(options) { options_.Check(); }

@@ -67,6 +67,10 @@ struct Se3TrackerOptions {
   /// only with more consistent points by this share of the points in view (results in one
   /// basin differ by well under 1%; the stray re-track that motivated Refine, by 16%).
   double refine_margin = 0.05;
+  /// A re-acquisition after a loss (FrameTracker::Reacquires) needs at least this many
+  /// consistent points besides a confident result: a few hundred points of a smooth wall
+  /// match at a wrong pose (docs/math/tracking.md, "Re-acquisition"). 0 disables.
+  int min_reacquisition_points = 1000;
 
   void Check() const;
 };

@@ -74,15 +74,23 @@ TEST_F(FrameTrackerGapTest, FrameRateJitterKeepsTheVelocityAsMeasured) {
   EXPECT_EQ(with.T_kf_frame.Log(), without.T_kf_frame.Log());
 }
 
-// Right after a loss only a confident result re-acquires: ok and at least
-// suspect_good_ratio consistent (on the room patrol, recoveries of 61-66% consistent points
-// after a textureless wall were 25-44 degrees off).
+// Right after a loss only a confident result re-acquires: ok, at least suspect_good_ratio
+// consistent and at least min_reacquisition_points consistent points (on the room patrols,
+// recoveries of 61-66% consistent points, and later of 79-87% but only 172-401 points, after
+// a textureless wall were 25-104 degrees off).
 TEST(FrameTracker, OnlyAConfidentResultReacquires) {
   const FrameTracker tracker{Se3TrackerOptions{}};
   TrackingResult result;
   result.status = TrackingStatus::kOk;
   result.stats.good_ratio = 0.9;
+  result.stats.points_good = Se3TrackerOptions{}.min_reacquisition_points;
   EXPECT_TRUE(tracker.Reacquires(result));
+  result.stats.points_good -= 1;  // confident, but too few points to pin a pose down
+  EXPECT_FALSE(tracker.Reacquires(result));
+  Se3TrackerOptions counting_nothing;
+  counting_nothing.min_reacquisition_points = 0;
+  EXPECT_TRUE(FrameTracker(counting_nothing).Reacquires(result));
+  result.stats.points_good = 5000;
   result.stats.good_ratio = 0.65;  // ok, but a result the tracker would search again
   EXPECT_FALSE(tracker.Reacquires(result));
   result.stats.good_ratio = 0.9;
