@@ -27,7 +27,16 @@ TrackingResult FrameTracker::Track(const TrackingReference& reference, const Fra
   const double gap = frame.Timestamp() - state_.last_timestamp;  // NaN after no frame
   TrackingResult tracked = tracker_.Track(
       reference, frame, MotionHypotheses(state_.T_kf_last, VelocityOver(gap)), state_.affine);
-  if (tracked.status == TrackingStatus::kLost) return tracked;
+  if (tracked.status != TrackingStatus::kLost && !AgreesWithHistory(tracked)) {
+    tracked.status = TrackingStatus::kLost;
+    tracked.stats.reason = "residual far above the last tracked frame's";
+  }
+  if (tracked.status == TrackingStatus::kLost) {
+    lost_since_state_ = true;
+    return tracked;
+  }
+  lost_since_state_ = false;
+  state_.residual_rms = tracked.stats.residual_rms;
   state_.velocity_interval = gap > 0.0 ? gap : 0.0;
   state_.last_timestamp = frame.Timestamp();
   state_.T_prev_last = state_.T_kf_last.Inverse() * tracked.T_kf_frame;
@@ -45,6 +54,15 @@ TrackingResult FrameTracker::TrackFrom(const TrackingReference& reference, const
 TrackingResult FrameTracker::Retrack(const TrackingReference& reference, const Frame& frame,
                                      const SE3d& guess, const AffineBrightness& affine) {
   return tracker_.Refine(reference, frame, guess, affine);
+}
+
+bool FrameTracker::AgreesWithHistory(const TrackingResult& result) const {
+  const double jump = tracker_.Options().max_residual_jump;
+  // Right after a loss a confident result is held to the bar as well: it has no motion
+  // behind it (a textureless wall: confident at 6x the residual, 45 degrees off).
+  return jump <= 0.0 || !(state_.residual_rms > 0.0) ||
+         (tracker_.Confident(result) && !lost_since_state_) ||
+         result.stats.residual_rms <= jump * state_.residual_rms;
 }
 
 bool FrameTracker::Reacquires(const TrackingResult& result) const {
@@ -65,7 +83,9 @@ std::optional<std::pair<std::size_t, TrackingResult>> FrameTracker::Recover(
       r = tracker_.Track(*c.reference, frame, {SE3d()}, AffineBrightness{});
     }
     if (!Reacquires(r)) continue;
-    state_ = MotionState{r.T_kf_frame, SE3d(), r.affine, 1, frame.Timestamp(), 0.0};
+    state_ = MotionState{r.T_kf_frame,        SE3d(), r.affine, 1, frame.Timestamp(), 0.0,
+                         r.stats.residual_rms};
+    lost_since_state_ = false;
     return std::make_pair(k, std::move(r));
   }
   return std::nullopt;
@@ -73,7 +93,8 @@ std::optional<std::pair<std::size_t, TrackingResult>> FrameTracker::Recover(
 
 void FrameTracker::StartKeyframe() {
   // The brightness estimate carries over: the same camera sees the same scene.
-  state_ = MotionState{SE3d(), SE3d(), state_.affine, 0, state_.last_timestamp, 0.0};
+  state_ = MotionState{
+      SE3d(), SE3d(), state_.affine, 0, state_.last_timestamp, 0.0, state_.residual_rms};
 }
 
 }  // namespace parallax

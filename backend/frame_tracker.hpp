@@ -27,6 +27,8 @@ struct MotionState {
   /// spans (0: unknown), so that the guess can follow the time a gap of frames took.
   double last_timestamp = std::numeric_limits<double>::quiet_NaN();
   double velocity_interval = 0.0;
+  /// Residual rms of the last tracked frame, grey levels (0: unknown).
+  double residual_rms = 0.0;
 };
 
 /// A keyframe to try when tracking is lost on the current one.
@@ -47,6 +49,11 @@ class FrameTracker {
   /// advances the motion state (a lost one keeps the last good state). The velocity is
   /// rescaled to the frame's time gap beyond `velocity_rescale_ratio` (Se3TrackerOptions).
   TrackingResult Track(const TrackingReference& reference, const Frame& frame);
+  /// Whether a result tracked with the motion model agrees with the frames before it: a
+  /// result that is not confident (Se3Tracker::Confident) with a residual above
+  /// `max_residual_jump` times the last tracked frame's does not, and Track reports it lost
+  /// (docs/math/tracking.md, "A residual far above the last frame's").
+  bool AgreesWithHistory(const TrackingResult& result) const;
   /// One start, no state change (frames tracked again during initialisation).
   TrackingResult TrackFrom(const TrackingReference& reference, const Frame& frame,
                            const SE3d& guess, const AffineBrightness& affine);
@@ -79,6 +86,7 @@ class FrameTracker {
 
   Se3Tracker tracker_;
   double velocity_rescale_ratio_;
+  bool lost_since_state_ = false;  ///< a frame was lost since the state's last tracked frame
   MotionState state_;
 };
 

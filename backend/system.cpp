@@ -369,7 +369,7 @@ void System::SwitchKeyframe(const std::shared_ptr<const Frame>& frame, const Ima
   mapper_.Direction().SetKeyframe(frame->Id(), image);
   // Constant-velocity guess for the next frame in the new keyframe's units.
   tracker_.SetState(MotionState{SE3d(), velocity, AffineBrightness{}, 0, last.last_timestamp,
-                                last.velocity_interval});
+                                last.velocity_interval, last.residual_rms});
   result->is_keyframe = true;
 }
 

@@ -43,6 +43,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"velocity_rescale_ratio", Set(&o->tracker.velocity_rescale_ratio)},
         {"refine_margin", Set(&o->tracker.refine_margin)},
         {"min_reacquisition_points", Set(&o->tracker.min_reacquisition_points)},
+        {"max_residual_jump", Set(&o->tracker.max_residual_jump)},
         {"min_good_ratio_ok", Set(&o->tracker.min_good_ratio_ok)},
         {"min_good_ratio_poor", Set(&o->tracker.min_good_ratio_poor)}}},
       {"depth",

@@ -93,6 +93,8 @@ void Se3TrackerOptions::Check() const {
   CheckOption(refine_margin >= 0.0 && refine_margin <= 1.0, s, "refine_margin",
               "must be in [0, 1]");
   CheckOption(min_reacquisition_points >= 0, s, "min_reacquisition_points", "must be >= 0");
+  CheckOption(max_residual_jump >= 0.0 && std::isfinite(max_residual_jump), s, "max_residual_jump",
+              "must be finite and >= 0");
 }
 
 Se3Tracker::Se3Tracker(const Se3TrackerOptions& options) : options_(options) { options_.Check(); }

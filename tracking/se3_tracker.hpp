@@ -71,6 +71,10 @@ struct Se3TrackerOptions {
   /// consistent points besides a confident result: a few hundred points of a smooth wall
   /// match at a wrong pose (docs/math/tracking.md, "Re-acquisition"). 0 disables.
   int min_reacquisition_points = 1000;
+  /// A frame tracked with the motion model whose result is not confident and whose residual
+  /// rms is above this factor times the last tracked frame's is reported lost
+  /// (FrameTracker::AgreesWithHistory): a view explained away at a wrong pose. 0 disables.
+  double max_residual_jump = 3.0;
 
   void Check() const;
 };

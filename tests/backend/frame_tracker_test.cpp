@@ -74,6 +74,35 @@ TEST_F(FrameTrackerGapTest, FrameRateJitterKeepsTheVelocityAsMeasured) {
   EXPECT_EQ(with.T_kf_frame.Log(), without.T_kf_frame.Log());
 }
 
+// A result that is not confident with a residual above max_residual_jump times the last
+// tracked frame's disagrees with the frames before it; right after a lost frame a confident
+// one is held to the same bar (on the room patrols such results were 20-90 degrees off).
+TEST_F(FrameTrackerGapTest, AResidualFarAboveTheLastFramesDisagreesWithHistory) {
+  FrameTracker tracker{Se3TrackerOptions{}};
+  for (const int index : {1, 2}) {
+    ASSERT_EQ(tracker.Track(*reference_, *FrameAt(index)).status, TrackingStatus::kOk);
+  }
+  const double last = tracker.State().residual_rms;
+  ASSERT_GT(last, 0.0);
+  TrackingResult result;
+  result.status = TrackingStatus::kOk;
+  result.stats.good_ratio = 0.65;  // ok, not confident
+  result.stats.residual_rms = 2.9 * last;
+  EXPECT_TRUE(tracker.AgreesWithHistory(result));
+  result.stats.residual_rms = 3.1 * last;
+  EXPECT_FALSE(tracker.AgreesWithHistory(result));
+  result.stats.good_ratio = 0.9;  // confident, with the motion model behind it
+  EXPECT_TRUE(tracker.AgreesWithHistory(result));
+  // A black frame is lost; the state stays the last tracked frame's.
+  const Frame black(3, 3.0 / motion_.fps, test::TestCamera(), ImageU8(640, 480));
+  ASSERT_EQ(tracker.Track(*reference_, black).status, TrackingStatus::kLost);
+  EXPECT_EQ(tracker.State().residual_rms, last);
+  EXPECT_FALSE(tracker.AgreesWithHistory(result));  // confident, but right after a loss
+  Se3TrackerOptions off;
+  off.max_residual_jump = 0.0;
+  EXPECT_TRUE(FrameTracker(off).AgreesWithHistory(result));
+}
+
 // Right after a loss only a confident result re-acquires: ok, at least suspect_good_ratio
 // consistent and at least min_reacquisition_points consistent points (on the room patrols,
 // recoveries of 61-66% consistent points, and later of 79-87% but only 172-401 points, after
