@@ -83,8 +83,8 @@ std::optional<std::pair<std::size_t, TrackingResult>> FrameTracker::Recover(
       r = tracker_.Track(*c.reference, frame, {SE3d()}, AffineBrightness{});
     }
     if (!Reacquires(r)) continue;
-    state_ = MotionState{r.T_kf_frame,        SE3d(), r.affine, 1, frame.Timestamp(), 0.0,
-                         r.stats.residual_rms};
+    state_ = MotionState{r.T_kf_frame, SE3d(), r.affine, 1, frame.Timestamp(), 0.0};
+    state_.residual_rms = r.stats.residual_rms;
     lost_since_state_ = false;
     return std::make_pair(k, std::move(r));
   }

@@ -49,10 +49,11 @@ class FrameTracker {
   /// advances the motion state (a lost one keeps the last good state). The velocity is
   /// rescaled to the frame's time gap beyond `velocity_rescale_ratio` (Se3TrackerOptions).
   TrackingResult Track(const TrackingReference& reference, const Frame& frame);
-  /// Whether a result tracked with the motion model agrees with the frames before it: a
-  /// result that is not confident (Se3Tracker::Confident) with a residual above
-  /// `max_residual_jump` times the last tracked frame's does not, and Track reports it lost
-  /// (docs/math/tracking.md, "A residual far above the last frame's").
+  /// Whether a result tracked with the motion model agrees with the frames before it: one
+  /// with a residual above `max_residual_jump` times the last tracked frame's does not unless
+  /// it is confident (Se3Tracker::Confident) and Track lost no frame since that one; Track
+  /// reports it lost (docs/math/tracking.md, "A residual far above the last frame's"). Frames
+  /// the System declares lost without tracking them (unusable input) do not count as lost.
   bool AgreesWithHistory(const TrackingResult& result) const;
   /// One start, no state change (frames tracked again during initialisation).
   TrackingResult TrackFrom(const TrackingReference& reference, const Frame& frame,
@@ -86,7 +87,7 @@ class FrameTracker {
 
   Se3Tracker tracker_;
   double velocity_rescale_ratio_;
-  bool lost_since_state_ = false;  ///< a frame was lost since the state's last tracked frame
+  bool lost_since_state_ = false;  ///< Track lost a frame since the state's last tracked one
   MotionState state_;
 };
 
