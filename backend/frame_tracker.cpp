@@ -27,7 +27,13 @@ TrackingResult FrameTracker::Track(const TrackingReference& reference, const Fra
   const double gap = frame.Timestamp() - state_.last_timestamp;  // NaN after no frame
   TrackingResult tracked = tracker_.Track(
       reference, frame, MotionHypotheses(state_.T_kf_last, VelocityOver(gap)), state_.affine);
-  if (tracked.status != TrackingStatus::kLost && !AgreesWithHistory(tracked)) {
+  // The last frame's residual is a bar for the next frame, not for one after frames that
+  // never reached the tracker (dropped at a camera's rate, skipped, unusable): the view has
+  // moved on meanwhile. Frames lost here are no such gap.
+  const bool after_gap = state_.velocity_interval > 0.0 &&
+                         gap > velocity_rescale_ratio_ * state_.velocity_interval &&
+                         !lost_since_state_;
+  if (!after_gap && tracked.status != TrackingStatus::kLost && !AgreesWithHistory(tracked)) {
     tracked.status = TrackingStatus::kLost;
     tracked.stats.reason = "residual far above the last tracked frame's";
   }

@@ -52,8 +52,8 @@ class FrameTracker {
   /// Whether a result tracked with the motion model agrees with the frames before it: one
   /// with a residual above `max_residual_jump` times the last tracked frame's does not unless
   /// it is confident (Se3Tracker::Confident) and Track lost no frame since that one; Track
-  /// reports it lost (docs/math/tracking.md, "A residual far above the last frame's"). Frames
-  /// the System declares lost without tracking them (unusable input) do not count as lost.
+  /// reports it lost (docs/math/tracking.md, "A residual far above the last frame's"), except
+  /// after a gap of frames that never reached it (dropped, skipped, unusable).
   bool AgreesWithHistory(const TrackingResult& result) const;
   /// One start, no state change (frames tracked again during initialisation).
   TrackingResult TrackFrom(const TrackingReference& reference, const Frame& frame,
