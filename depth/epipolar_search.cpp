@@ -213,9 +213,12 @@ StereoObservation EpipolarSearch::Observe(int x, int y, float min_idepth, float 
   const float baseline_relative = options_.baseline_sigma / std::max(t_.norm(), 1e-9f);
   // A rotation known to rotation_sigma of itself moves the match by that share of the
   // rotation's image motion (where a point at infinity goes); along the line it is disparity.
-  const Eigen::Vector2f rotation_flow(fx_ * Rq.x() / Rq.z() + cx_ - static_cast<float>(x),
-                                      fy_ * Rq.y() / Rq.z() + cy_ - static_cast<float>(y));
-  const float rotation_along = options_.rotation_sigma * rotation_flow.dot(dir);
+  const float rotation_along =
+      options_.rotation_sigma > 0.0f && Rq.z() > 0.0f
+          ? options_.rotation_sigma *
+                (project(0.0f) - Eigen::Vector2f(static_cast<float>(x), static_cast<float>(y)))
+                    .dot(dir)
+          : 0.0f;
   out.status = StereoStatus::kOk;
   out.idepth = d;
   out.variance =

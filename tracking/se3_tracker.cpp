@@ -217,6 +217,12 @@ TrackingResult Se3Tracker::Finish(const TrackingReference& reference, const Stat
 
 TrackingResult Se3Tracker::TrackFrom(const TrackingReference& reference, const Frame& frame,
                                      const SE3d& T_kf_frame, const AffineBrightness& affine_guess) {
+  return TrackLevels(reference, frame, T_kf_frame, affine_guess, reference.NumLevels() - 1);
+}
+
+TrackingResult Se3Tracker::TrackLevels(const TrackingReference& reference, const Frame& frame,
+                                       const SE3d& T_kf_frame, const AffineBrightness& affine_guess,
+                                       int coarsest) {
   CheckArgument(frame.NumLevels() >= reference.NumLevels(),
                 "Se3Tracker: the frame has fewer pyramid levels than the keyframe");
   State state{T_kf_frame.Inverse(), options_.estimate_affine ? affine_guess : AffineBrightness{}};
@@ -227,7 +233,7 @@ TrackingResult Se3Tracker::TrackFrom(const TrackingReference& reference, const F
                 "(TrackingReferenceOptions::finest_level)");
   std::array<int, kMaxPyramidLevels> iterations{};
   LevelEvaluation finest_evaluation;
-  for (int level = reference.NumLevels() - 1; level >= finest; --level) {
+  for (int level = std::max(coarsest, finest); level >= finest; --level) {
     iterations[static_cast<std::size_t>(level)] = OptimizeLevel(
         reference, frame, level, MaxIterationsForLevel(options_.max_iterations, level), prior,
         &state, &finest_evaluation);
@@ -240,22 +246,12 @@ TrackingResult Se3Tracker::TrackFrom(const TrackingReference& reference, const F
 TrackingResult Se3Tracker::Refine(const TrackingReference& reference, const Frame& frame,
                                   const SE3d& T_kf_frame, const AffineBrightness& affine_guess) {
   TrackingResult tracked = Track(reference, frame, {T_kf_frame}, affine_guess);
-  State state{T_kf_frame.Inverse(), options_.estimate_affine ? affine_guess : AffineBrightness{}};
-  const AffineBrightness prior = state.affine;
-  const int finest = std::min(options_.finest_level, reference.NumLevels() - 1);
-  LevelEvaluation evaluation;
-  const int iterations = OptimizeLevel(reference, frame, finest,
-                                       MaxIterationsForLevel(options_.max_iterations, finest),
-                                       prior, &state, &evaluation);
-  TrackingResult local = Finish(reference, state, evaluation);
-  local.stats.iterations[static_cast<std::size_t>(finest)] = iterations;
+  TrackingResult local = TrackLevels(reference, frame, T_kf_frame, affine_guess, 0);
   local.stats.hypotheses_tried = tracked.stats.hypotheses_tried + 1;
   // Two results of one basin differ by a few points either way; only a clear gain is another.
-  const double margin = options_.refine_margin * tracked.stats.points_in_view;
-  const bool better = local.status < tracked.status ||
-                      (local.status == tracked.status &&
-                       local.stats.points_good > tracked.stats.points_good + margin);
-  return better ? local : tracked;
+  return ExplainsMore(local, tracked, options_.refine_margin * tracked.stats.points_in_view)
+             ? local
+             : tracked;
 }
 
 bool Se3Tracker::Confident(const TrackingResult& result) const {
@@ -302,13 +298,15 @@ TrackingResult Se3Tracker::Track(const TrackingReference& reference, const Frame
     // Of two results with the same status, the one that explains more of the map: the share
     // of consistent points alone prefers a pose that sees fewer of them (docs/math/
     // tracking.md, "Comparing two results").
-    const bool better = alternative.status < best.status ||
-                        (alternative.status == best.status &&
-                         alternative.stats.points_good > best.stats.points_good);
-    if (better) best = alternative;
+    if (ExplainsMore(alternative, best, 0.0)) best = alternative;
   }
   best.stats.hypotheses_tried = static_cast<int>(candidates.size()) + 1;
   return best;
+}
+
+bool ExplainsMore(const TrackingResult& a, const TrackingResult& b, double margin) {
+  return a.status < b.status ||
+         (a.status == b.status && a.stats.points_good > b.stats.points_good + margin);
 }
 
 void AddRotations(const SE3d& T_kf_frame, const std::vector<double>& angles_deg,

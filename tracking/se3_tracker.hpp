@@ -137,6 +137,11 @@ class Se3Tracker {
     AffineBrightness affine;
   };
   double Cost(const LevelEvaluation& e, const State& s, const AffineBrightness& prior) const;
+  /// One coarse-to-fine run from one guess over levels [finest, max(coarsest, finest)]
+  /// (TrackFrom: every level; Refine: the finest alone).
+  TrackingResult TrackLevels(const TrackingReference& reference, const Frame& frame,
+                             const SE3d& T_kf_frame, const AffineBrightness& affine_guess,
+                             int coarsest);
   /// Optimises `state` on `level`; `final_evaluation` receives the level's evaluation at the
   /// returned state.
   int OptimizeLevel(const TrackingReference& reference, const Frame& frame, int level,
@@ -154,6 +159,10 @@ class Se3Tracker {
 /// motion T_prev_last (pose of the last frame in the previous one): constant velocity, half
 /// and double velocity, zero motion, and the keyframe pose itself.
 std::vector<SE3d> MotionHypotheses(const SE3d& T_kf_last, const SE3d& T_prev_last);
+/// Of two results, whether `a` explains more of the map than `b`: a better status, or the
+/// same with more than `margin` more consistent points (docs/math/tracking.md, "Comparing two
+/// results").
+bool ExplainsMore(const TrackingResult& a, const TrackingResult& b, double margin);
 /// Appends, for each angle (degrees), the six poses turned by +-angle about each camera axis.
 void AddRotations(const SE3d& T_kf_frame, const std::vector<double>& angles_deg,
                   std::vector<SE3d>* candidates);

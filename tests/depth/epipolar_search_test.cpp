@@ -73,6 +73,23 @@ class EpipolarSearchTest : public ::testing::Test {
     return s;
   }
 
+  /// Observes every 7th pixel with a true depth by both searches (prior +-10% around the
+  /// truth): the statuses must agree; `compare(x, y, d, a, b)` gets every pair observed ok.
+  template <typename Compare>
+  static void ForEachPair(const EpipolarSearch& a, const EpipolarSearch& b, Compare compare) {
+    const ImageF& truth = keyframe_->idepth;
+    for (int y = 20; y < truth.Height() - 20; y += 7) {
+      for (int x = 20; x < truth.Width() - 20; x += 7) {
+        const float d = truth(x, y);
+        if (!(d > 0.0f)) continue;
+        const StereoObservation oa = a.Observe(x, y, 0.9f * d, 1.1f * d, d, 30.0f);
+        const StereoObservation ob = b.Observe(x, y, 0.9f * d, 1.1f * d, d, 30.0f);
+        ASSERT_EQ(oa.status, ob.status);
+        if (oa.status == StereoStatus::kOk) compare(x, y, d, oa, ob);
+      }
+    }
+  }
+
   static inline std::unique_ptr<synth::Scene> scene_;
   static inline SE3d T_w_kf_;
   static inline std::unique_ptr<test::RenderedKeyframe> keyframe_;
@@ -185,21 +202,12 @@ TEST_F(EpipolarSearchTest, BaselineUncertaintyAddsToTheVariance) {
   const StereoFrame stereo{frame.get(), SE3d(SO3d(), t).Inverse()};
   const EpipolarSearch a(*keyframe_->frame, stereo, without), b(*keyframe_->frame, stereo, with);
   int compared = 0;
-  const ImageF& truth = keyframe_->idepth;
-  for (int y = 20; y < truth.Height() - 20; y += 7) {
-    for (int x = 20; x < truth.Width() - 20; x += 7) {
-      const float d = truth(x, y);
-      if (!(d > 0.0f)) continue;
-      const StereoObservation oa = a.Observe(x, y, 0.9f * d, 1.1f * d, d, 30.0f);
-      const StereoObservation ob = b.Observe(x, y, 0.9f * d, 1.1f * d, d, 30.0f);
-      ASSERT_EQ(oa.status, ob.status);
-      if (oa.status != StereoStatus::kOk) continue;
-      ++compared;
-      EXPECT_EQ(oa.idepth, ob.idepth);
-      const float extra = oa.idepth * oa.idepth * 0.2f * 0.2f;  // (0.002 / 0.01)^2
-      EXPECT_NEAR(ob.variance - oa.variance, extra, 1e-3f * extra);
-    }
-  }
+  ForEachPair(a, b, [&](int, int, float, const StereoObservation& oa, const StereoObservation& ob) {
+    ++compared;
+    EXPECT_EQ(oa.idepth, ob.idepth);
+    const float extra = oa.idepth * oa.idepth * 0.2f * 0.2f;  // (0.002 / 0.01)^2
+    EXPECT_NEAR(ob.variance - oa.variance, extra, 1e-3f * extra);
+  });
   EXPECT_GT(compared, 500);
 }
 
@@ -223,32 +231,24 @@ TEST_F(EpipolarSearchTest, RotationUncertaintyAddsToTheVariance) {
   int compared = 0;
   int within_2_percent = 0;
   double largest_extra = 0.0;  // relative to the variance without
-  const ImageF& truth = keyframe_->idepth;
-  for (int y = 20; y < truth.Height() - 20; y += 7) {
-    for (int x = 20; x < truth.Width() - 20; x += 7) {
-      const float d = truth(x, y);
-      if (!(d > 0.0f)) continue;
-      const StereoObservation oa = a.Observe(x, y, 0.9f * d, 1.1f * d, d, 30.0f);
-      const StereoObservation ob = b.Observe(x, y, 0.9f * d, 1.1f * d, d, 30.0f);
-      ASSERT_EQ(oa.status, ob.status);
-      if (oa.status != StereoStatus::kOk) continue;
-      ++compared;
-      EXPECT_EQ(oa.idepth, ob.idepth);
-      const Eigen::Vector2d u(x, y);
-      const Eigen::Vector3d Rq = R * camera.Unproject(u);
-      const auto project = [&](double idepth) { return camera.Project(Rq + idepth * t); };
-      const Eigen::Vector2d dir = (project(1.1 * d) - project(0.9 * d)).normalized();
-      const double h = 1e-4 * oa.idepth;
-      const double alpha = 2.0 * h / (project(oa.idepth + h) - project(oa.idepth - h)).norm();
-      const double along = 0.02 * (project(0.0) - u).dot(dir);
-      const double extra = alpha * alpha * along * along;
-      // alpha here is a derivative, the search's a difference over a pixel: equal to 2% but
-      // near the epipole, where the inverse depth along the line curves.
-      EXPECT_NEAR(ob.variance - oa.variance, extra, 0.1 * extra + 1e-12);
-      if (std::abs(ob.variance - oa.variance - extra) <= 0.02 * extra + 1e-12) ++within_2_percent;
-      largest_extra = std::max(largest_extra, extra / oa.variance);
-    }
-  }
+  ForEachPair(
+      a, b, [&](int x, int y, float d, const StereoObservation& oa, const StereoObservation& ob) {
+        ++compared;
+        EXPECT_EQ(oa.idepth, ob.idepth);
+        const Eigen::Vector2d u(x, y);
+        const Eigen::Vector3d Rq = R * camera.Unproject(u);
+        const auto project = [&](double idepth) { return camera.Project(Rq + idepth * t); };
+        const Eigen::Vector2d dir = (project(1.1 * d) - project(0.9 * d)).normalized();
+        const double h = 1e-4 * oa.idepth;
+        const double alpha = 2.0 * h / (project(oa.idepth + h) - project(oa.idepth - h)).norm();
+        const double along = 0.02 * (project(0.0) - u).dot(dir);
+        const double extra = alpha * alpha * along * along;
+        // alpha here is a derivative, the search's a difference over a pixel: equal to 2% but
+        // near the epipole, where the inverse depth along the line curves.
+        EXPECT_NEAR(ob.variance - oa.variance, extra, 0.1 * extra + 1e-12);
+        if (std::abs(ob.variance - oa.variance - extra) <= 0.02 * extra + 1e-12) ++within_2_percent;
+        largest_extra = std::max(largest_extra, extra / oa.variance);
+      });
   EXPECT_GT(compared, 500);
   EXPECT_GE(within_2_percent, compared * 99 / 100);
   EXPECT_GT(largest_extra, 0.1);  // the term matters: about 20 px of image motion
@@ -260,18 +260,10 @@ TEST_F(EpipolarSearchTest, RotationUncertaintyAddsToTheVariance) {
   const EpipolarSearch c(*keyframe_->frame, straight, without),
       e(*keyframe_->frame, straight, with);
   int unchanged = 0;
-  for (int y = 20; y < truth.Height() - 20; y += 7) {
-    for (int x = 20; x < truth.Width() - 20; x += 7) {
-      const float d = truth(x, y);
-      if (!(d > 0.0f)) continue;
-      const StereoObservation oc = c.Observe(x, y, 0.9f * d, 1.1f * d, d, 30.0f);
-      const StereoObservation oe = e.Observe(x, y, 0.9f * d, 1.1f * d, d, 30.0f);
-      if (oc.status != StereoStatus::kOk) continue;
-      ASSERT_EQ(oe.status, StereoStatus::kOk);
-      EXPECT_EQ(oc.variance, oe.variance);
-      ++unchanged;
-    }
-  }
+  ForEachPair(c, e, [&](int, int, float, const StereoObservation& oc, const StereoObservation& oe) {
+    EXPECT_EQ(oc.variance, oe.variance);
+    ++unchanged;
+  });
   EXPECT_GT(unchanged, 500);
 }
 
