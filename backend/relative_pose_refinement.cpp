@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <limits>
 
 #include "core/check.hpp"
 
@@ -37,6 +38,12 @@ double HuberCost(double r, double k) {
   return a <= k ? 0.5 * r * r : k * (a - 0.5 * k);
 }
 
+struct NormalEquations {
+  Matrix5d H = Matrix5d::Zero();
+  Vector5d g = Vector5d::Zero();
+  double weighted_squares = 0.0;  ///< sum of w r^2, pixels^2
+};
+
 struct Problem {
   const std::vector<Eigen::Vector2d>& x_ref;
   const std::vector<Eigen::Vector2d>& x_cur;
@@ -49,6 +56,26 @@ struct Problem {
     for (std::size_t i = 0; i < x_ref.size(); ++i)
       r[static_cast<Eigen::Index>(i)] = focal_px * SampsonDistance(E, x_ref[i], x_cur[i]);
     return r;
+  }
+  /// Gauss-Newton normal equations with Huber (IRLS) weights at `pose`, whose residuals are
+  /// `r`; the Jacobian by central differences (the residual is smooth and cheap).
+  NormalEquations Linearise(const RelativePose& pose, const Eigen::VectorXd& r) const {
+    constexpr double kStep = 1e-6;
+    Eigen::MatrixXd J(r.size(), 5);
+    for (int k = 0; k < 5; ++k) {
+      Vector5d h = Vector5d::Zero();
+      h[k] = kStep;
+      J.col(k) = (Residuals(Retract(pose, h)) - Residuals(Retract(pose, -h))) / (2.0 * kStep);
+    }
+    NormalEquations eq;
+    for (Eigen::Index i = 0; i < r.size(); ++i) {
+      const double a = std::abs(r[i]);
+      const double w = a <= huber_px ? 1.0 : huber_px / a;
+      eq.H.noalias() += w * J.row(i).transpose() * J.row(i);
+      eq.g.noalias() += w * J.row(i).transpose() * r[i];
+      eq.weighted_squares += w * r[i] * r[i];
+    }
+    return eq;
   }
   double Cost(const Eigen::VectorXd& r) const {
     double c = 0.0;
@@ -96,24 +123,9 @@ RelativePose RefineRelativePose(const std::vector<Eigen::Vector2d>& x_ref,
   RelativePose pose = initial;
   Eigen::VectorXd r = problem.Residuals(pose);
   double cost = problem.Cost(r);
-  constexpr double kStep = 1e-6;  // central differences: the residual is smooth and cheap
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
-    Eigen::MatrixXd J(r.size(), 5);
-    for (int k = 0; k < 5; ++k) {
-      Vector5d h = Vector5d::Zero();
-      h[k] = kStep;
-      J.col(k) = (problem.Residuals(Retract(pose, h)) - problem.Residuals(Retract(pose, -h))) /
-                 (2.0 * kStep);
-    }
-    Matrix5d H = Matrix5d::Zero();
-    Vector5d g = Vector5d::Zero();
-    for (Eigen::Index i = 0; i < r.size(); ++i) {
-      const double a = std::abs(r[i]);
-      const double w = a <= options.huber_px ? 1.0 : options.huber_px / a;  // IRLS weight
-      H.noalias() += w * J.row(i).transpose() * J.row(i);
-      g.noalias() += w * J.row(i).transpose() * r[i];
-    }
-    const Vector5d delta = -H.ldlt().solve(g);
+    const NormalEquations eq = problem.Linearise(pose, r);
+    const Vector5d delta = -eq.H.ldlt().solve(eq.g);
     if (!delta.allFinite()) break;
     // Halve the step until the robust cost decreases (Gauss-Newton can overshoot).
     bool improved = false;
@@ -131,6 +143,23 @@ RelativePose RefineRelativePose(const std::vector<Eigen::Vector2d>& x_ref,
     if (!improved || delta.norm() < options.min_step) break;
   }
   return pose;
+}
+
+Eigen::Matrix<double, 5, 5> RelativePoseCovariance(const std::vector<Eigen::Vector2d>& x_ref,
+                                                   const std::vector<Eigen::Vector2d>& x_cur,
+                                                   const RelativePose& pose, double focal_px,
+                                                   double huber_px) {
+  CheckArgument(x_ref.size() == x_cur.size() && x_ref.size() > 5,
+                "RelativePoseCovariance: point counts differ or are below 6");
+  const Problem problem{x_ref, x_cur, focal_px, huber_px};
+  const NormalEquations eq = problem.Linearise(pose, problem.Residuals(pose));
+  const double variance = eq.weighted_squares / static_cast<double>(x_ref.size() - 5);
+  const Eigen::LDLT<Matrix5d> ldlt(eq.H);
+  const Matrix5d inverse = ldlt.solve(Matrix5d::Identity());
+  if (ldlt.info() != Eigen::Success || !inverse.allFinite()) {
+    return Matrix5d::Constant(std::numeric_limits<double>::infinity());
+  }
+  return variance * inverse;
 }
 
 }  // namespace parallax

@@ -50,4 +50,15 @@ RelativePose RefineRelativePose(const std::vector<Eigen::Vector2d>& x_ref,
                                 const RelativePose& initial, double focal_px,
                                 const RelativePoseRefinementOptions& options = {});
 
+/// Covariance of a refined pose's five parameters at `pose`: the rotation on the left
+/// (radians, rows 0-2) and the unit translation on its tangent plane (rows 3-4), as
+/// sigma^2 (J^T W J)^-1 with the Huber weights of RefineRelativePose and sigma^2 the weighted
+/// residual variance (pixels^2). Where the turn/sideways-step ambiguity of a narrow lens
+/// leaves the motion undetermined, the rotation block is large (docs/math/two_view.md).
+/// Precondition: at least 6 correspondences; returns infinities when the Hessian is singular.
+Eigen::Matrix<double, 5, 5> RelativePoseCovariance(const std::vector<Eigen::Vector2d>& x_ref,
+                                                   const std::vector<Eigen::Vector2d>& x_cur,
+                                                   const RelativePose& pose, double focal_px,
+                                                   double huber_px);
+
 }  // namespace parallax

@@ -1,7 +1,9 @@
 #include "backend/two_view_bootstrap.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/features2d.hpp>
@@ -33,6 +35,8 @@ void TwoViewBootstrapOptions::Check() const {
   CheckOption(max_homography_share > 0.0 && max_homography_share <= 1.0, "TwoViewBootstrapOptions",
               "max_homography_share", "must be in (0, 1]");
   CheckOption(min_twin_cost_ratio >= 0.0, "TwoViewBootstrapOptions", "min_twin_cost_ratio",
+              "must be >= 0");
+  CheckOption(max_offset_sigma >= 0.0, "TwoViewBootstrapOptions", "max_offset_sigma",
               "must be >= 0");
 }
 
@@ -189,6 +193,20 @@ RelativePose PolishOnInliers(const PinholeCamera& camera, const PixelCorresponde
                             0.5 * (camera.Fx() + camera.Fy()));
 }
 
+/// Standard deviation of the polished rotation along its least determined axis, radians.
+double RotationSigma(const PinholeCamera& camera, const PixelCorrespondences& inliers,
+                     const RelativePose& pose) {
+  if (inliers.ref.size() < 6) return std::numeric_limits<double>::infinity();
+  const Eigen::Matrix3d covariance =
+      RelativePoseCovariance(Normalised(camera, inliers.ref), Normalised(camera, inliers.cur), pose,
+                             0.5 * (camera.Fx() + camera.Fy()),
+                             RelativePoseRefinementOptions{}.huber_px)
+          .topLeftCorner<3, 3>();
+  if (!covariance.allFinite()) return std::numeric_limits<double>::infinity();
+  return std::sqrt(std::max(
+      0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues().maxCoeff()));
+}
+
 /// False when the pair's inliers do not determine its motion (docs/math/two_view.md,
 /// "Ambiguous pairs"): a homography explains too many of them, or another motion explains
 /// them almost as well.
@@ -239,11 +257,18 @@ std::optional<TwoViewPair> TwoViewBootstrap::TryFrame(const ImageU8& image) {
   const PixelCorrespondences inliers = Inlying(matches, tri.match_index);
   const RelativePose refined =
       PolishOnInliers(impl_->camera, inliers, {SO3d(R_e), t_e.normalized()});
+  // |t| = 1 in recoverPose's units; scale so the median reference depth becomes 1.
+  const double median_depth = KthLargest(tri.depths, static_cast<int>(tri.depths.size() / 2) + 1);
+  const double rotation_sigma = RotationSigma(impl_->camera, inliers, refined);
+  pair.rotation_sigma_deg = rotation_sigma * kRadToDeg;
+  pair.inverse_depth_offset_sigma = rotation_sigma * median_depth;
+  if (options.max_offset_sigma > 0.0 &&
+      !(pair.inverse_depth_offset_sigma <= options.max_offset_sigma)) {
+    return std::nullopt;
+  }
   if (!Determined(impl_->camera, options, inliers, refined)) {
     return std::nullopt;
   }
-  // |t| = 1 in recoverPose's units; scale so the median reference depth becomes 1.
-  const double median_depth = KthLargest(tri.depths, static_cast<int>(tri.depths.size() / 2) + 1);
   pair.T_frame_ref = SE3d(refined.R_cur_ref, refined.t_cur_ref / median_depth);
   pair.inliers = static_cast<int>(tri.depths.size());
   std::vector<double> ref_means, cur_means;

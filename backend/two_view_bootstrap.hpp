@@ -30,6 +30,11 @@ struct TwoViewBootstrapOptions {
   /// them as the pair's pose is, explains them at less than this multiple of the pair's robust
   /// cost (the essential matrix has found one of two near-equal solutions). 0: no test.
   double min_twin_cost_ratio = 1.25;
+  /// A pair is refused while the turn/sideways-step ambiguity leaves the reference's inverse
+  /// depths uncertain by a common offset above this (median depth 1; the pair's
+  /// `inverse_depth_offset_sigma`): a start on such a pair carries the offset as a turn-rate
+  /// error for as long as its depth is propagated (docs/math/two_view.md). 0: no gate.
+  double max_offset_sigma = 0.008;
 
   void Check() const;
 };
@@ -44,6 +49,12 @@ struct TwoViewPair {
   float gain = 1.0f;
   float offset = 0.0f;        ///< grey levels
   double parallax_deg = 0.0;  ///< the `parallax_points`-th largest triangulation angle
+  /// Standard deviation of the rotation along its least determined axis, degrees
+  /// (RelativePoseCovariance), and the same divided by the baseline in median-depth units: the
+  /// uncertainty of a constant added to the reference's inverse depths (median depth 1) that
+  /// the turn/sideways-step ambiguity leaves (docs/math/two_view.md).
+  double rotation_sigma_deg = 0.0;
+  double inverse_depth_offset_sigma = 0.0;
   int inliers = 0;
 };
 

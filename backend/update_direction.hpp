@@ -52,14 +52,15 @@ struct UpdateDirectionOptions {
   /// ... and while the frame has turned at most this much from the checked one, degrees (in
   /// a turn, where the tracked yaw and direction go wrong together, every update is checked).
   double reuse_max_rotation_deg = 1.0;
-  /// The start's ambiguity tests are off here: each check is blended in only after agreeing
-  /// with the tracked pose within max_angle_deg, which a twin solution does not.
+  /// The start's ambiguity and conditioning tests are off here: each check is blended in only
+  /// after agreeing with the tracked pose within max_angle_deg, which a twin solution does not.
   TwoViewBootstrapOptions matcher{.max_features = 800,
                                   .min_inliers = 100,
                                   .min_parallax_deg = 0.5,
                                   .parallax_points = 30,
                                   .max_homography_share = 1.0,
-                                  .min_twin_cost_ratio = 0.0};
+                                  .min_twin_cost_ratio = 0.0,
+                                  .max_offset_sigma = 0.0};
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;

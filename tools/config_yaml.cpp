@@ -84,6 +84,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"bootstrap_min_inliers", Set(&o->bootstrap.min_inliers)},
         {"bootstrap_max_homography_share", Set(&o->bootstrap.max_homography_share)},
         {"bootstrap_min_twin_cost_ratio", Set(&o->bootstrap.min_twin_cost_ratio)},
+        {"bootstrap_max_offset_sigma", Set(&o->bootstrap.max_offset_sigma)},
         {"keyframe_distance", Set(&o->keyframe_distance)},
         {"min_keyframe_usage", Set(&o->min_keyframe_usage)},
         {"min_keyframe_good_ratio", Set(&o->min_keyframe_good_ratio)},

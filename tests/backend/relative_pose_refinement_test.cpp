@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <random>
 
@@ -99,6 +100,47 @@ TEST(RefineRelativePose, TooFewPointsReturnTheStart) {
   RelativePoseRefinementOptions bad;
   bad.huber_px = 0.0;
   EXPECT_THROW(bad.Check(), std::invalid_argument);
+}
+
+// The predicted covariance against the spread of the refined poses over noise draws, on a
+// sideways step with a turn (the ambiguous case: the rotation's worst axis is the turn
+// coupled with the step).
+TEST(RelativePoseCovariance, MatchesTheSpreadOverNoiseDraws) {
+  const RelativePose truth{SO3d::Exp(Eigen::Vector3d(0.0, 0.04, 0.0)),
+                           Eigen::Vector3d(1.0, 0.0, 0.1).normalized()};
+  constexpr int kDraws = 150;
+  constexpr double kNoisePx = 0.5;
+  Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d predicted = Eigen::Matrix3d::Zero();
+  for (int draw = 0; draw < kDraws; ++draw) {
+    const Correspondences c = Make(truth, 200, kNoisePx, 100 + static_cast<std::uint32_t>(draw));
+    const RelativePose refined = RefineRelativePose(c.ref, c.cur, truth, kFocal);
+    const Eigen::Vector3d error = (refined.R_cur_ref * truth.R_cur_ref.Inverse()).Log();
+    spread += error * error.transpose() / kDraws;
+    predicted +=
+        RelativePoseCovariance(c.ref, c.cur, refined, kFocal, 1.0).topLeftCorner<3, 3>() / kDraws;
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(predicted);
+  const Eigen::Vector3d worst = eigen.eigenvectors().col(2);
+  const double predicted_deg = std::sqrt(eigen.eigenvalues()[2]) * kRadToDeg;
+  const double measured_deg = std::sqrt(worst.dot(spread * worst)) * kRadToDeg;
+  RecordProperty("predicted_deg", std::to_string(predicted_deg));
+  RecordProperty("measured_deg", std::to_string(measured_deg));
+  EXPECT_GT(measured_deg, 0.75 * predicted_deg);
+  EXPECT_LT(measured_deg, 1.33 * predicted_deg);
+  // The turn about the vertical axis, coupled with the sideways step, is the worst axis.
+  EXPECT_GT(std::abs(worst.y()), 0.9);
+  // A 20 times smaller noise predicts a 20 times smaller spread.
+  const Correspondences quiet = Make(truth, 200, kNoisePx / 20.0, 7);
+  const double quiet_deg =
+      std::sqrt(RelativePoseCovariance(quiet.ref, quiet.cur, truth, kFocal, 1.0)
+                    .topLeftCorner<3, 3>()
+                    .eigenvalues()
+                    .real()
+                    .maxCoeff()) *
+      kRadToDeg;
+  EXPECT_NEAR(quiet_deg, predicted_deg / 20.0, 0.3 * predicted_deg / 20.0);
+  EXPECT_THROW(RelativePoseCovariance(quiet.ref, {}, truth, kFocal, 1.0), std::invalid_argument);
 }
 
 }  // namespace
