@@ -50,9 +50,9 @@ struct TwoViewPair {
   float offset = 0.0f;        ///< grey levels
   double parallax_deg = 0.0;  ///< the `parallax_points`-th largest triangulation angle
   /// Standard deviation of the rotation along its least determined axis, degrees
-  /// (RelativePoseCovariance), and the same divided by the baseline in median-depth units: the
-  /// uncertainty of a constant added to the reference's inverse depths (median depth 1) that
-  /// the turn/sideways-step ambiguity leaves (docs/math/two_view.md).
+  /// (RelativePoseCovariance); and that sigma in radians divided by the baseline in
+  /// median-depth units: the uncertainty of a constant added to the reference's inverse depths
+  /// (median depth 1) that the turn/sideways-step ambiguity leaves (docs/math/two_view.md).
   double rotation_sigma_deg = 0.0;
   double inverse_depth_offset_sigma = 0.0;
   int inliers = 0;
