@@ -186,20 +186,27 @@ PixelCorrespondences Inlying(const Matches& matches, const std::vector<std::size
   return c;
 }
 
+/// The inliers in normalised image coordinates, for the polish and its covariance.
+struct NormalisedInliers {
+  std::vector<Eigen::Vector2d> ref, cur;
+  double focal_px = 0.0;
+};
+
+NormalisedInliers Normalise(const PinholeCamera& camera, const PixelCorrespondences& inliers) {
+  return {Normalised(camera, inliers.ref), Normalised(camera, inliers.cur),
+          0.5 * (camera.Fx() + camera.Fy())};
+}
+
 /// The RANSAC model is a 5-point solution; every cheirality-checked inlier refines it.
-RelativePose PolishOnInliers(const PinholeCamera& camera, const PixelCorrespondences& inliers,
-                             const RelativePose& pose) {
-  return RefineRelativePose(Normalised(camera, inliers.ref), Normalised(camera, inliers.cur), pose,
-                            0.5 * (camera.Fx() + camera.Fy()));
+RelativePose PolishOnInliers(const NormalisedInliers& inliers, const RelativePose& pose) {
+  return RefineRelativePose(inliers.ref, inliers.cur, pose, inliers.focal_px);
 }
 
 /// Standard deviation of the polished rotation along its least determined axis, radians.
-double RotationSigma(const PinholeCamera& camera, const PixelCorrespondences& inliers,
-                     const RelativePose& pose) {
+double RotationSigma(const NormalisedInliers& inliers, const RelativePose& pose) {
   if (inliers.ref.size() < 6) return std::numeric_limits<double>::infinity();
   const Eigen::Matrix3d covariance =
-      RelativePoseCovariance(Normalised(camera, inliers.ref), Normalised(camera, inliers.cur), pose,
-                             0.5 * (camera.Fx() + camera.Fy()),
+      RelativePoseCovariance(inliers.ref, inliers.cur, pose, inliers.focal_px,
                              RelativePoseRefinementOptions{}.huber_px)
           .topLeftCorner<3, 3>();
   if (!covariance.allFinite()) return std::numeric_limits<double>::infinity();
@@ -255,11 +262,11 @@ std::optional<TwoViewPair> TwoViewBootstrap::TryFrame(const ImageU8& image) {
   pair.parallax_deg = KthLargest(tri.angles_deg, options.parallax_points);
   if (pair.parallax_deg < options.min_parallax_deg) return std::nullopt;
   const PixelCorrespondences inliers = Inlying(matches, tri.match_index);
-  const RelativePose refined =
-      PolishOnInliers(impl_->camera, inliers, {SO3d(R_e), t_e.normalized()});
+  const NormalisedInliers normalised = Normalise(impl_->camera, inliers);
+  const RelativePose refined = PolishOnInliers(normalised, {SO3d(R_e), t_e.normalized()});
   // |t| = 1 in recoverPose's units; scale so the median reference depth becomes 1.
   const double median_depth = KthLargest(tri.depths, static_cast<int>(tri.depths.size() / 2) + 1);
-  const double rotation_sigma = RotationSigma(impl_->camera, inliers, refined);
+  const double rotation_sigma = RotationSigma(normalised, refined);
   pair.rotation_sigma_deg = rotation_sigma * kRadToDeg;
   pair.inverse_depth_offset_sigma = rotation_sigma * median_depth;
   if (options.max_offset_sigma > 0.0 &&
