@@ -100,7 +100,13 @@ TEST(MappingWorker, StopDropsWaitingJobsAndRefusesNewOnes) {
   GatedProcess process;
   MappingWorker worker(process.Function(), 8, 1, 1);
   for (int id = 0; id < 5; ++id) worker.Offer(Job(id));
-  std::thread opener([&] { process.open.set_value(); });
+  // The gate opens only once Stop has dropped the waiting jobs: WaitFor on a frame that is
+  // never mapped returns when the worker stops. (Opening it at once let the thread map a
+  // second job before Stop took the lock, under load.)
+  std::thread opener([&] {
+    worker.WaitFor(1000);
+    process.open.set_value();
+  });
   worker.Stop();
   opener.join();
   EXPECT_LE(process.seen.size(), 1u);  // at most the one running when stopped
@@ -140,7 +146,13 @@ TEST(MappingWorker, AWaitForEndsWhenTheWorkerStops) {
   kept.keep = true;
   worker.Offer(std::move(kept));
   std::thread waiter([&] { worker.WaitFor(5); });
-  std::thread opener([&] { process.open.set_value(); });
+  // The gate opens only once Stop has dropped the waiting jobs: WaitFor on a frame that is
+  // never mapped returns when the worker stops. (Opening it at once let the thread map a
+  // second job before Stop took the lock, under load.)
+  std::thread opener([&] {
+    worker.WaitFor(1000);
+    process.open.set_value();
+  });
   worker.Stop();
   waiter.join();
   opener.join();
