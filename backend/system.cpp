@@ -33,6 +33,7 @@ void SystemOptions::Check() const {
               "keyframe_refinement_min_window", ">= 2");
   CheckOption(keyframe_window_capacity >= keyframe_refinement_frames, "SystemOptions",
               "keyframe_window_capacity", ">= keyframe_refinement_frames");
+  CheckOption(spread_max_step_change >= 0.0, "SystemOptions", "spread_max_step_change", ">= 0");
   bootstrap.Check();
   quality.Check();
   backend.Check();
@@ -141,6 +142,7 @@ void System::StartKeyframe(const std::shared_ptr<const Frame>& frame, const Sim3
     // Relative to the keyframe it grew from, before the backend moves that one.
     next.parent = current_.id;
     next.S_parent_kf = CurrentKeyframePose().Inverse() * S_w_kf;
+    tracked_keyframes_[next.id] = TrackedKeyframe{current_.id, next.S_parent_kf};
     FinishCurrentKeyframe(result);
     mapper_.Retire();
   }
@@ -421,16 +423,18 @@ std::vector<KeyframeRecord> System::Keyframes() const {
 std::vector<FramePose> System::Trajectory() const {
   const std::lock_guard<std::mutex> engine(engine_mutex_);
   const std::lock_guard<std::mutex> frames(poses_mutex_);
-  std::vector<FramePose> poses;
-  for (std::size_t k = 0; k < frame_poses_.size(); ++k) {
-    const auto& anchor = frame_poses_[k];
-    // A frame anchored to a keyframe of a map discarded by a restart has no pose any more.
-    if (!anchor || (anchor->keyframe_id != current_.id && !graph_.Contains(anchor->keyframe_id)))
-      continue;
-    const Sim3d S_w_kf = KeyframePose(anchor->keyframe_id);
-    poses.push_back({first_frame_id_ + static_cast<std::int64_t>(k), frame_timestamps_[k],
-                     (S_w_kf * Sim3d(anchor->T_kf_frame)).RigidPart()});
-  }
+  FrameAnchors anchored;
+  anchored.anchors = &frame_poses_;
+  anchored.first_frame_id = first_frame_id_;
+  anchored.tracked = &tracked_keyframes_;
+  anchored.max_step_change = options_.spread_max_step_change;
+  anchored.keyframe_pose = [this](std::int64_t id) -> std::optional<Sim3d> {
+    // A keyframe of a map discarded by a restart: its frames have no pose any more.
+    if (id != current_.id && !graph_.Contains(id)) return std::nullopt;
+    return KeyframePose(id);
+  };
+  std::vector<FramePose> poses = FrameWorldPoses(anchored, options_.spread_keyframe_corrections);
+  for (FramePose& pose : poses) pose.timestamp = frame_timestamps_[FrameIndex(pose.frame_id)];
   return poses;
 }
 

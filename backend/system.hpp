@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "backend/frame_tracker.hpp"
+#include "backend/frame_trajectory.hpp"
 #include "backend/graph_backend.hpp"
 #include "backend/keyframe_graph.hpp"
 #include "backend/keyframe_refinement.hpp"
@@ -313,6 +314,8 @@ class System {
     Sim3d S_parent_kf;  ///< S_w_kf when there is no parent
   };
   CurrentKeyframe current_;
+  /// Every keyframe that grew from another: where tracking placed it (FrameWorldPoses).
+  std::map<std::int64_t, TrackedKeyframe> tracked_keyframes_;
   /// Per frame (index = frame id): its anchored pose, if it has one, and its timestamp.
   std::vector<std::optional<AnchoredPose>> frame_poses_;
   std::vector<double> frame_timestamps_;

@@ -157,6 +157,13 @@ struct SystemOptions {
   /// Constraint search and pose-graph optimisation when a keyframe is finished; false keeps
   /// the tracking chain as it is (odometry edges only, never optimised).
   bool optimize_graph = true;
+  /// trajectory.txt: the frames tracked towards a keyframe follow the graph's correction of
+  /// it in part, growing along the way, instead of keeping their tracked pose relative to the
+  /// keyframe they were tracked against up to the next one (backend/frame_trajectory.hpp).
+  bool spread_keyframe_corrections = true;
+  /// ... unless the keyframe's tracked step departs from the frames' motion by more than
+  /// this times the step before it (FrameAnchors::max_step_change).
+  double spread_max_step_change = 1.0;
   GraphBackendOptions backend;
   /// Place recognition and loop closure on finished keyframes (needs optimize_graph).
   LoopClosureOptions loop_closure;

@@ -118,6 +118,8 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
          Set(&o->keyframe_refinement.max_point_relative_sigma)},
         {"keyframe_window_capacity", Set(&o->keyframe_window_capacity)},
         {"optimize_graph", Set(&o->optimize_graph)},
+        {"spread_keyframe_corrections", Set(&o->spread_keyframe_corrections)},
+        {"spread_max_step_change", Set(&o->spread_max_step_change)},
         {"new_map_after_lost_s", Set(&o->new_map_after_lost_s)}}},
       {"backend",
        {{"neighbour_max_distance", Set(&o->backend.neighbour_max_distance)},

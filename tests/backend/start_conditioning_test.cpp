@@ -8,6 +8,7 @@
 
 #include "backend/system.hpp"
 #include "core/angles.hpp"
+#include "tests/backend/orbit_fixture.hpp"
 #include "tools/synth/scene.hpp"
 #include "tools/synth/synthetic_sequence.hpp"
 
@@ -17,11 +18,7 @@ namespace {
 /// Heading error (degrees) of frame `last` relative to frame 0, against ground truth,
 /// after running the first `last + 1` frames of the 300-frame room orbit of seed 3.
 double HeadingErrorAfter(int last, double max_offset_sigma) {
-  synth::SynthOptions synth_options;
-  synth_options.scene = "room";
-  synth_options.motion = "orbit";
-  synth_options.frames = 300;
-  synth_options.seed = 3;
+  const synth::SynthOptions synth_options = test::RoomOrbit(300, 3);
   const synth::Scene scene = synth::MakeScene(synth_options.scene, synth_options.seed);
   SystemOptions options;
   options.bootstrap.max_offset_sigma = max_offset_sigma;
