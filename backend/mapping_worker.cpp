@@ -66,6 +66,23 @@ void MappingWorker::Offer(MappingJob job, bool wait_for_room) {
   wake_.notify_one();
 }
 
+void MappingWorker::Queue(MappingJob job, std::size_t max_queued) {
+  job.keep = true;  // never skipped
+  job.caller_idle = true;
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    const auto queued = [this] {
+      return static_cast<std::size_t>(std::count_if(
+          queue_.begin(), queue_.end(), [](const Entry& e) { return e.job.caller_idle; }));
+    };
+    idle_.wait(lock, [&] { return queued() < max_queued || stopping_ || failure_; });
+    RethrowFailure();
+    CheckState(!stopping_, "MappingWorker::Queue: stopped");
+    queue_.push_back({std::move(job), nullptr});
+  }
+  wake_.notify_one();
+}
+
 FrameResult MappingWorker::Run(MappingJob job) {
   auto done = std::make_shared<std::promise<FrameResult>>();
   std::future<FrameResult> result = done->get_future();
@@ -119,10 +136,11 @@ void MappingWorker::Loop() {
       queue_.pop_front();
       busy_ = true;
     }
+    idle_.notify_all();  // room in the queue: a caller waiting for room goes on now
     const bool waited = entry.done != nullptr;
     std::exception_ptr error;
     std::optional<FrameResult> result;
-    (waited ? waited_arena_ : arena_).execute([&] {
+    (waited || entry.job.caller_idle ? waited_arena_ : arena_).execute([&] {
       try {
         result = process_(entry.job);
       } catch (...) {
@@ -136,7 +154,7 @@ void MappingWorker::Loop() {
     {
       const std::lock_guard<std::mutex> lock(mutex_);
       if (error && !waited) failure_ = error;
-      done_through_ = std::max(done_through_, entry.job.frame ? entry.job.frame->Id() : -1);
+      done_through_ = std::max(done_through_, entry.job.FrameId());
       busy_ = false;
     }
     idle_.notify_all();

@@ -35,6 +35,8 @@ struct LiveTracking {
 /// A frame for the mapping thread; `live` is empty when the mapping thread must track it
 /// itself (the start, a lost frame).
 struct MappingJob {
+  /// Empty: the mapping thread builds it from `image`, `unbuilt_id` and `unbuilt_timestamp`
+  /// (a start frame: its pyramid's first touch of new memory costs the caller nothing).
   std::shared_ptr<const Frame> frame;
   ImageU8 image;  ///< the undistorted 8-bit image
   std::optional<LiveTracking> live;
@@ -44,8 +46,16 @@ struct MappingJob {
   /// newer than the mapping thread's when mapping skipped frames (keyframe_id -1: none).
   LiveTracking hint;
   /// The caller's previous frame got no pose (System: a "poor" tracking right after a loss
-  /// is not trusted).
-  bool previous_lost = false;
+  /// is not trusted); empty for a frame the caller did not try to track (the start): the
+  /// mapping thread's own record of its previous frame holds.
+  std::optional<bool> previous_lost;
+  /// Queued by Queue(): the caller's thread is idle meanwhile (the start answered at once),
+  /// so the job gets the waited jobs' wider arena.
+  bool caller_idle = false;
+  std::int64_t unbuilt_id = -1;
+  double unbuilt_timestamp = 0.0;
+
+  std::int64_t FrameId() const { return frame ? frame->Id() : unbuilt_id; }
 };
 
 class MappingWorker {
@@ -66,6 +76,10 @@ class MappingWorker {
   /// converges only from the frames it maps). Rethrows (once) an exception an earlier
   /// refinement threw.
   void Offer(MappingJob job, bool wait_for_room = false);
+  /// Queues a job that is never skipped and runs with the waited jobs' wider arena while
+  /// the caller's thread is idle (the start, answered at once); waits while `max_queued`
+  /// (>= 1) such jobs are waiting. Rethrows as Offer does.
+  void Queue(MappingJob job, std::size_t max_queued);
   /// Queues a job behind the waiting ones and returns its result (rethrowing its exception).
   FrameResult Run(MappingJob job);
   /// Returns once the job of frame `frame_id` (or a later frame's) is done, or the worker

@@ -153,6 +153,11 @@ class System {
   void TakePendingEvents(FrameResult* result);
   FrameResult WaitForMapping(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
                              std::optional<LiveTracking> live, LiveTracking hint);
+  /// Before the map is initialised: hands the frame to mapping and answers without a pose.
+  FrameResult QueueStartFrame(std::int64_t id, double timestamp, const ImageU8& image);
+  /// After start frames were queued: once the start is usable, waits until mapping has done
+  /// them and adopts its state; returns the snapshot to track against.
+  LiveSnapshot CatchUpWithStart(LiveSnapshot snapshot);
   void ForEachMapPointLocked(const std::function<void(const MapPoint&)>& fn) const;
   std::vector<std::uint8_t> EncodeMapBytesLocked() const;
   void StartKeyframe(const std::shared_ptr<const Frame>& frame, const Sim3d& S_w_kf,

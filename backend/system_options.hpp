@@ -56,6 +56,16 @@ struct RealtimeOptions {
   /// shares them with tracking and mapping, which go first when it is positive.
   int backend_threads = 1;
   int backend_nice = 10;
+  /// Until the map is initialised (the start, and a new map after a long loss) a frame is
+  /// handed to the mapping thread and answered at once without a pose (initialising; its
+  /// pose comes with the map: poses revised). false: the caller waits until its own frame is
+  /// mapped (its provisional pose comes back with the answer).
+  bool answer_start_at_once = true;
+  /// ... none of them is skipped; when this many wait for mapping (1 s of a 30 Hz camera) the
+  /// caller waits too (a recording fed faster than the start maps). When the start is
+  /// complete the caller waits once until mapping has done the queued frames, then tracks
+  /// live from mapping's newest state.
+  int max_queued_start_frames = 30;
 
   void Check() const;
 };

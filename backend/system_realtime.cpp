@@ -33,6 +33,8 @@ void RealtimeOptions::Check() const {
   CheckOption(backend_threads >= 1, "RealtimeOptions", "backend_threads", "must be >= 1");
   CheckOption(backend_nice >= 0 && backend_nice <= 19, "RealtimeOptions", "backend_nice",
               "must be in [0, 19]");
+  CheckOption(max_queued_start_frames >= 1, "RealtimeOptions", "max_queued_start_frames",
+              "must be >= 1");
 }
 
 void System::StartRealtime() {
@@ -95,6 +97,7 @@ RealtimeStats System::Realtime() const {
   if (!live_) return stats;
   stats.frames_tracked_live = live_->tracked_live;
   stats.frames_mapped_waiting = live_->mapped_waiting;
+  stats.frames_queued_for_start = live_->queued_for_start;
   stats.frames_waiting_for_keyframe = live_->waited_for_keyframe;
   stats.frames_skipped_by_mapping = worker_->Skipped();
   return stats;
@@ -116,12 +119,47 @@ FrameResult System::WaitForMapping(const std::shared_ptr<const Frame>& frame, co
   return result;
 }
 
+FrameResult System::QueueStartFrame(std::int64_t id, double timestamp, const ImageU8& image) {
+  // The start's frames are mapped in order as in the deterministic mode, by the mapping
+  // thread (with both cores: the caller is idle), which also builds their pyramids: the
+  // first touch of a buffered frame's new memory costs about 17 ms at 640x480 here
+  // (docs/realtime.md). The caller waits only when max_queued_start_frames wait already (a
+  // recording fed faster than the start maps).
+  MappingJob job{nullptr, image, std::nullopt, false, false, LiveTracking{}, std::nullopt};
+  job.unbuilt_id = id;
+  job.unbuilt_timestamp = timestamp;
+  worker_->Queue(std::move(job),
+                 static_cast<std::size_t>(options_.realtime.max_queued_start_frames));
+  live_->last_queued_start = id;
+  ++live_->queued_for_start;
+  FrameResult result;
+  result.initialising = true;
+  result.answered_before_mapping = true;
+  TakePendingEvents(&result);
+  return result;
+}
+
+LiveSnapshot System::CatchUpWithStart(LiveSnapshot snapshot) {
+  // The start completed behind the caller: the frames queued after the one that completed
+  // it are mapped in order first, once (the caller waits), so that live tracking continues
+  // from the mapping thread's newest frame rather than from a pose frames behind.
+  if (!snapshot.usable || live_->last_queued_start < 0) return snapshot;
+  worker_->WaitFor(std::exchange(live_->last_queued_start, -1));
+  ++live_->caught_up_with_start;
+  snapshot = live_->Latest();
+  live_->Adopt(snapshot);
+  return snapshot;
+}
+
 FrameResult System::ProcessLive(std::int64_t id, double timestamp, const ImageU8& image) {
+  LiveSnapshot snapshot = CatchUpWithStart(live_->Latest());
+  if (!snapshot.usable && options_.realtime.answer_start_at_once) {
+    return QueueStartFrame(id, timestamp, image);
+  }
   std::shared_ptr<const Frame> frame;
   live_->arena.execute([&] {
     frame = std::make_shared<const Frame>(id, timestamp, camera_, image, options_.pyramid);
   });
-  LiveSnapshot snapshot = live_->Latest();
   if (!snapshot.usable) return WaitForMapping(frame, image, std::nullopt, LiveTracking{});
   live_->Follow(snapshot);
   const MotionState before = live_->tracker.State();
@@ -251,13 +289,17 @@ FrameResult System::MapJob(const MappingJob& job) {
         job.hint.generation == map_generation_ && start_ == StartState::kInitialised) {
       tracker_.SetState(job.hint.motion);
     }
-    previous_frame_lost_ = job.previous_lost;
-    result = ProcessInOrder(job.frame, job.image);
+    if (job.previous_lost) previous_frame_lost_ = *job.previous_lost;
+    const std::shared_ptr<const Frame> frame =
+        job.frame ? job.frame
+                  : std::make_shared<const Frame>(job.unbuilt_id, job.unbuilt_timestamp, camera_,
+                                                  job.image, options_.pyramid);
+    result = ProcessInOrder(frame, job.image);
     // A frame the caller already has a pose for keeps it when tracking it again here failed.
     if (!result.T_w_c && job.live && !job.caller_waits) {
       FrameResult live;
       live.anchor = AnchoredPose{job.live->keyframe_id, job.live->tracked.T_kf_frame};
-      Record(job.frame->Id(), live);
+      Record(job.FrameId(), live);
     }
   }
   result.mapping_ms = MillisecondsSince(start);

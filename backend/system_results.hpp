@@ -66,6 +66,8 @@ struct RealtimeStats {
   std::int64_t frames_tracked_live = 0;  ///< answered by the caller's tracker alone
   /// The caller waited for mapping to track the frame itself (start, lost, no keyframe).
   std::int64_t frames_mapped_waiting = 0;
+  /// Answered at once without a pose before the map was initialised, mapped behind.
+  std::int64_t frames_queued_for_start = 0;
   /// The caller waited for a keyframe it had asked for, then tracked the frame itself.
   std::int64_t frames_waiting_for_keyframe = 0;
   std::int64_t frames_skipped_by_mapping = 0;  ///< tracked, never used to refine depth
@@ -111,6 +113,10 @@ struct FrameResult {
   /// The map had no initialised keyframe yet when the frame was posed (its pose is
   /// provisional: the start may revise or withdraw it).
   bool initialising = false;
+  /// Answered before it was mapped (the real-time start, RealtimeOptions::
+  /// answer_start_at_once): no pose yet and not lost; its pose, if the start gives it one,
+  /// comes with the map (kPosesRevised, System::Trajectory).
+  bool answered_before_mapping = false;
   TrackingStats stats;
   double tracking_ms = 0.0;  ///< wall time of tracking this frame
   double mapping_ms = 0.0;   ///< depth update and keyframe creation

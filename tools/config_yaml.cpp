@@ -168,7 +168,9 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"keyframe_wait_factor", Set(&o->realtime.keyframe_wait_factor)},
         {"snapshot_keyframe_poses", Set(&o->realtime.snapshot_keyframe_poses)},
         {"backend_threads", Set(&o->realtime.backend_threads)},
-        {"backend_nice", Set(&o->realtime.backend_nice)}}},
+        {"backend_nice", Set(&o->realtime.backend_nice)},
+        {"answer_start_at_once", Set(&o->realtime.answer_start_at_once)},
+        {"max_queued_start_frames", Set(&o->realtime.max_queued_start_frames)}}},
   };
 }
 

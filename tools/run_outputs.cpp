@@ -128,6 +128,7 @@ void WriteStats(const std::string& path, const RunSummary& s) {
                        {"frames_dropped", s.frames_dropped},
                        {"frames_tracked_live", s.mapping.frames_tracked_live},
                        {"frames_waiting_for_mapping", s.mapping.frames_mapped_waiting},
+                       {"frames_queued_for_start", s.mapping.frames_queued_for_start},
                        {"frames_waiting_for_keyframe", s.mapping.frames_waiting_for_keyframe},
                        {"frames_skipped_by_mapping", s.mapping.frames_skipped_by_mapping},
                        {"shutdown_ms", s.shutdown_ms}};
@@ -209,10 +210,11 @@ std::string RunOutputs::Path(const std::string& name) const {
 }
 
 void RunOutputs::LogFrame(int index, double timestamp, const FrameResult& result) {
-  frame_log_ << fmt::format("{},{},{},{},{},{:.3f},{:.3f},{}\n", index, TimestampText(timestamp),
-                            ToString(result.status), result.T_w_c ? 1 : 0,
-                            result.is_keyframe ? 1 : 0, result.tracking_ms, result.mapping_ms,
-                            EventNames(result.events));
+  frame_log_ << fmt::format(
+      "{},{},{},{},{},{:.3f},{:.3f},{}\n", index, TimestampText(timestamp),
+      result.answered_before_mapping ? "initialising" : ToString(result.status),
+      result.T_w_c ? 1 : 0, result.is_keyframe ? 1 : 0, result.tracking_ms, result.mapping_ms,
+      EventNames(result.events));
   frame_log_.flush();
   if (!result.T_w_c) return;
   const Trajectory one{{timestamp, *result.T_w_c}};

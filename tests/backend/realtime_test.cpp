@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cmath>
 #include <future>
+#include <set>
 #include <thread>
 
 #include "backend/backend_worker.hpp"
@@ -139,6 +140,39 @@ TEST(MappingWorker, AKeyframeRequestGoesBeforeWaitingRefinementsAndCanBeWaitedFo
   EXPECT_EQ(static_cast<std::int64_t>(process.seen.size()) + worker.Skipped(), 4);
 }
 
+TEST(MappingWorker, QueuedJobsAreNeverSkippedAndWaitOnlyWhenTheQueueIsFull) {
+  GatedProcess process;
+  std::vector<int> widths;
+  MappingWorker worker(
+      [&](const MappingJob& job) {
+        widths.push_back(tbb::this_task_arena::max_concurrency());
+        return process.Function()(job);
+      },
+      1, 1, 2);
+  // Job 0 is taken by the thread (or still waits); with at most 3 waiting, 1-3 are queued
+  // without the caller waiting, although mapping is blocked at the gate.
+  for (int id = 0; id < 4; ++id) worker.Queue(Job(id), 3);
+  std::atomic<bool> returned{false};
+  std::thread caller([&] {
+    worker.Queue(Job(4), 3);  // full: waits until mapping takes one
+    returned = true;
+  });
+  worker.Offer(Job(5));  // a refinement, skipped by the keyframe request; queued jobs are not
+  MappingJob keyframe = Job(6);
+  keyframe.keep = true;
+  worker.Offer(std::move(keyframe));
+  EXPECT_FALSE(returned.load());
+  process.open.set_value();
+  caller.join();
+  worker.Drain();
+  // 4 entered when mapping took 1, after the keyframe request.
+  EXPECT_EQ(process.seen, (std::vector<std::int64_t>{0, 1, 2, 3, 6, 4}));
+  EXPECT_EQ(worker.Skipped(), 1);
+  // Queued jobs have the wider arena (the caller's thread is idle), offered ones not.
+  const int wide = MappingWorker::ArenaWidth(2);
+  EXPECT_EQ(widths, (std::vector<int>{wide, wide, wide, wide, MappingWorker::ArenaWidth(1), wide}));
+}
+
 TEST(MappingWorker, AWaitForEndsWhenTheWorkerStops) {
   GatedProcess process;
   MappingWorker worker(process.Function(), 4, 1, 1);
@@ -214,19 +248,39 @@ SystemOptions Realtime() {
   return options;
 }
 
+/// Frames with a lost event among `events`.
+std::set<std::int64_t> LostFrames(const std::vector<SystemEvent>& events) {
+  std::set<std::int64_t> lost;
+  for (const SystemEvent& e : events) {
+    if (e.kind == SystemEvent::Kind::kLost) lost.insert(e.frame_id);
+  }
+  return lost;
+}
+
 TEST(Realtime, AnOrbitFedAsFastAsTrackingGoesIsPosedInOneWorld) {
   System system(test::TestCamera(), Realtime());
   const int frames = 100;
-  int answered = 0;
+  std::vector<SystemEvent> events;
+  std::set<std::int64_t> answered;  // a live pose, or "initialising" with no pose yet
   for (int k = 0; k < frames; ++k) {
     const FrameResult r =
         system.ProcessFrame(test::RenderTestImage(Room(), OrbitPose(k)), k / 30.0);
-    answered += r.T_w_c || std::any_of(r.events.begin(), r.events.end(), [](const SystemEvent& e) {
-                  return e.kind == SystemEvent::Kind::kLost;
-                });
+    if (r.T_w_c || r.initialising) answered.insert(k);
+    events.insert(events.end(), r.events.begin(), r.events.end());
   }
-  system.FinishMapping();
-  EXPECT_EQ(answered, frames);  // every frame: a pose or an honest "lost"
+  const std::vector<SystemEvent> last = system.FinishMapping();
+  events.insert(events.end(), last.begin(), last.end());
+  // Every frame: a pose (live, or with the map after an "initialising" answer) or an honest
+  // "lost" event, never both.
+  const std::set<std::int64_t> lost = LostFrames(events);
+  std::set<std::int64_t> posed;
+  for (const FramePose& p : system.Trajectory()) posed.insert(p.frame_id);
+  for (int k = 0; k < frames; ++k) {
+    EXPECT_NE(posed.count(k) + lost.count(k), 0u) << "frame " << k;
+    EXPECT_TRUE(answered.count(k) != 0 || lost.count(k) != 0) << "frame " << k;
+    EXPECT_FALSE(posed.count(k) != 0 && lost.count(k) != 0 && answered.count(k) == 0)
+        << "frame " << k;
+  }
   const std::vector<FramePose> poses = system.Trajectory();
   std::vector<Eigen::Vector3d> estimate, truth;
   for (const FramePose& p : poses) {
@@ -245,6 +299,44 @@ TEST(Realtime, AnOrbitFedAsFastAsTrackingGoesIsPosedInOneWorld) {
   EXPECT_LT(ate, 0.05);
   EXPECT_GE(system.Keyframes().size(), 5u);
   EXPECT_GT(system.Realtime().frames_tracked_live, frames / 2);
+}
+
+TEST(Realtime, TheStartIsAnsweredAtOnceAndItsFramesArePosedWithTheMap) {
+  for (const bool at_once : {true, false}) {
+    SystemOptions options = Realtime();
+    options.realtime.answer_start_at_once = at_once;
+    System system(test::TestCamera(), options);
+    const int frames = 40;
+    int first_live = -1;
+    int provisional = 0;
+    for (int k = 0; k < frames; ++k) {
+      const FrameResult r =
+          system.ProcessFrame(test::RenderTestImage(Room(), OrbitPose(k)), k / 30.0);
+      if (r.T_w_c && r.initialising) ++provisional;
+      if (r.T_w_c && !r.initialising && first_live < 0) first_live = k;
+      // Answered at once: no pose (not even a provisional one) until the map is usable.
+      if (at_once && first_live < 0) {
+        EXPECT_FALSE(r.T_w_c) << "frame " << k;
+      }
+    }
+    system.FinishMapping();
+    const RealtimeStats stats = system.Realtime();
+    ASSERT_GT(first_live, 0) << "at_once " << at_once;
+    int start_posed = 0;
+    for (const FramePose& p : system.Trajectory()) start_posed += p.frame_id < first_live;
+    if (at_once) {
+      EXPECT_EQ(stats.frames_queued_for_start, first_live);
+      EXPECT_EQ(stats.frames_mapped_waiting, 0);  // the caller never waited for a start frame
+      EXPECT_EQ(provisional, 0);
+    } else {
+      EXPECT_EQ(stats.frames_queued_for_start, 0);
+      EXPECT_GT(stats.frames_mapped_waiting, 0);
+      EXPECT_GT(provisional, 0);
+    }
+    // Every start frame was mapped in order (none skipped): the start's frames have their
+    // poses in the final trajectory, as in the deterministic mode.
+    EXPECT_GE(start_posed, first_live - 1) << "at_once " << at_once;
+  }
 }
 
 TEST(Realtime, SystemsStoppedOrDestroyedMidStreamKeepTheirKeyframes) {
@@ -285,9 +377,10 @@ TEST(Realtime, SeveralThreadsFeedSeveralSystems) {
     feeders.emplace_back([&] {
       System system(test::TestCamera(), Realtime());
       for (std::size_t k = 0; k < images.size(); ++k) {
-        if (system.ProcessFrame(images[k], static_cast<double>(k) / 30.0).T_w_c) ++posed;
+        system.ProcessFrame(images[k], static_cast<double>(k) / 30.0);
       }
       system.FinishMapping();
+      posed += static_cast<int>(system.Trajectory().size());  // live, or with the map
     });
   }
   for (std::thread& t : feeders) t.join();

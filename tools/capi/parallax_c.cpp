@@ -202,6 +202,13 @@ PX_API px_status px_system_map_points(px_system* system, float* xyz, size_t capa
   });
 }
 
+PX_API px_status px_system_finish_mapping(px_system* system) {
+  return Guarded("px_system_finish_mapping", [&] {
+    std::unique_lock<std::mutex> lock;
+    Locked(system, &lock).FinishMapping();
+  });
+}
+
 PX_API px_status px_system_save_map(px_system* system, const char* path) {
   return Guarded("px_system_save_map", [&] {
     std::unique_lock<std::mutex> lock;

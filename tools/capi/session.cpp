@@ -171,6 +171,18 @@ std::optional<SE3d> Session::FramePose(std::int64_t frame_id) const {
   return it->T_w_c;
 }
 
+void Session::FinishMapping() {
+  RequireUsable();
+  FrameResult finished;
+  try {
+    finished.events = system_->FinishMapping();
+  } catch (const std::exception& e) {
+    failure_ = e.what();
+    throw;
+  }
+  QueueEvents(finished);
+}
+
 void Session::SaveMap(const std::string& path) const {
   RequireUsable();
   try {

@@ -53,6 +53,9 @@ class Session {
   /// Oldest pending event, and how many were dropped since the last call.
   std::optional<px_event> PollEvent(std::uint64_t* dropped);
 
+  /// System::FinishMapping: everything given so far mapped; its events queued. An engine
+  /// exception marks the session failed, as in ProcessFrame.
+  void FinishMapping();
   void SaveMap(const std::string& path) const;
   /// A new system with the map; swapped in only when the load succeeded.
   void LoadMap(const std::string& path);

@@ -48,7 +48,8 @@ typedef enum {
 } px_status;
 
 typedef enum {
-  PX_STATE_INITIALIZING, /* no map yet (has_pose may be 1: a provisional pose) */
+  PX_STATE_INITIALIZING, /* no map yet (has_pose may be 1: a provisional pose; in real-time
+                            mode 0: px_system_frame_pose has it once the start completes) */
   PX_STATE_TRACKING,
   PX_STATE_POOR,       /* tracked with few consistent pixels: the pose is less certain */
   PX_STATE_LOST,       /* no pose for this frame (never an invented one) */
@@ -101,6 +102,13 @@ PX_API px_status px_system_process_frame(px_system* system, const uint8_t* gray,
  * number needed and PX_ERROR_INVALID_ARGUMENT is returned. */
 PX_API px_status px_system_map_points(px_system* system, float* xyz, size_t capacity,
                                       size_t* count);
+
+/* Waits until every frame given so far is mapped and the current keyframe is finished (and
+ * optimised), as at the end of a sequence: in real-time mode the poses of frames answered
+ * before they were mapped (PX_STATE_INITIALIZING, has_pose 0) are then known to
+ * px_system_frame_pose. More frames may follow. Its events are queued for
+ * px_system_poll_event. */
+PX_API px_status px_system_finish_mapping(px_system* system);
 
 /* Writes the whole map (docs/map_files.md) atomically. PX_ERROR_INVALID_STATE before the
  * first keyframe is initialised; PX_ERROR_IO when the file cannot be written. */
