@@ -49,8 +49,7 @@ struct LiveTracker {
   std::int64_t tracked_live = 0;
   bool previous_lost = false;  ///< the caller's previous frame got no pose
   std::int64_t mapped_waiting = 0;
-  std::int64_t queued_for_start = 0;      ///< answered at once, mapped later (the start)
-  std::int64_t caught_up_with_start = 0;  ///< waits for mapping to finish the queued start
+  std::int64_t queued_for_start = 0;  ///< answered at once, mapped later (the start)
   /// The newest start frame queued for mapping and not yet caught up with (-1: none).
   std::int64_t last_queued_start = -1;
   /// The mapping thread's: the keyframe of its last snapshot, and the one before it.

@@ -219,7 +219,7 @@ FrameResult System::ProcessFrame(const ImageU8& image, double timestamp) {
   if (live_) {
     FrameResult result = ProcessLive(id, timestamp, image);
     // A start frame answered before it was mapped is not lost (it was not tried).
-    live_->previous_lost = !result.T_w_c && !result.initialising;
+    live_->previous_lost = !result.T_w_c && !result.answered_before_mapping;
     return result;
   }
   auto frame = std::make_shared<const Frame>(id, timestamp, camera_, image, options_.pyramid);

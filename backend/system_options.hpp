@@ -56,7 +56,8 @@ struct RealtimeOptions {
   /// shares them with tracking and mapping, which go first when it is positive.
   int backend_threads = 1;
   int backend_nice = 10;
-  /// Until the map is initialised (the start, and a new map after a long loss) a frame is
+  /// Until the map is usable (the start, a new map after a long loss, the first
+  /// relocalisation on a loaded map) a frame is
   /// handed to the mapping thread and answered at once without a pose (initialising; its
   /// pose comes with the map: poses revised). false: the caller waits until its own frame is
   /// mapped (its provisional pose comes back with the answer).

@@ -145,7 +145,6 @@ LiveSnapshot System::CatchUpWithStart(LiveSnapshot snapshot) {
   // from the mapping thread's newest frame rather than from a pose frames behind.
   if (!snapshot.usable || live_->last_queued_start < 0) return snapshot;
   worker_->WaitFor(std::exchange(live_->last_queued_start, -1));
-  ++live_->caught_up_with_start;
   snapshot = live_->Latest();
   live_->Adopt(snapshot);
   return snapshot;
