@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "core/check.hpp"
+#include "core/thread_name.hpp"
 
 namespace parallax {
 
@@ -58,6 +59,7 @@ std::int64_t BackendWorker::Runs() const {
 }
 
 void BackendWorker::Loop(int nice) {
+  NameThisThread("px-backend");
   if (nice != 0) {
     // Per-thread on Linux (the thread id as process id); failing leaves the default, which
     // only costs latency.

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "core/check.hpp"
+#include "core/thread_name.hpp"
 
 namespace parallax {
 
@@ -126,6 +127,7 @@ std::int64_t MappingWorker::Skipped() const {
 }
 
 void MappingWorker::Loop() {
+  NameThisThread("px-mapping");
   for (;;) {
     Entry entry;
     {

@@ -9,8 +9,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <future>
 #include <set>
+#include <string>
 #include <thread>
 
 #include "backend/backend_worker.hpp"
@@ -231,6 +234,29 @@ TEST(BackendWorker, ExceptionsReachTheCallerAndStopReportsWaitingWork) {
   EXPECT_FALSE(worker.Stop());  // nothing was waiting
   EXPECT_THROW(worker.Notify(), std::logic_error);
   EXPECT_FALSE(worker.Stop());  // idempotent
+}
+
+/// The names of this process's threads (Linux /proc), for the naming test.
+std::multiset<std::string> ThreadNames() {
+  std::multiset<std::string> names;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::ifstream comm(task.path() / "comm");
+    std::string name;
+    if (std::getline(comm, name)) names.insert(name);
+  }
+  return names;
+}
+
+TEST(Workers, TheirThreadsAreNamedForProfilersAndDebuggers) {
+  const std::size_t mapping_before = ThreadNames().count("px-mapping");
+  const std::size_t backend_before = ThreadNames().count("px-backend");
+  MappingWorker mapping([](const MappingJob&) { return FrameResult{}; }, 2, 1, 1);
+  BackendWorker backend([] {}, 1, 0);
+  mapping.Run(Job(1));  // the thread has started (and named itself) once a job has run
+  backend.Notify();
+  backend.Drain();
+  EXPECT_EQ(ThreadNames().count("px-mapping"), mapping_before + 1);
+  EXPECT_EQ(ThreadNames().count("px-backend"), backend_before + 1);
 }
 
 const synth::Scene& Room() {

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/check.hpp"
+#include "core/thread_name.hpp"
 
 namespace parallax {
 
@@ -23,6 +24,7 @@ CameraPlayback::~CameraPlayback() {
 }
 
 void CameraPlayback::Play() {
+  NameThisThread("px-camera");
   using Clock = std::chrono::steady_clock;
   std::optional<double> first_timestamp;
   Clock::time_point start;

@@ -3,6 +3,7 @@
 #include <limits>
 
 #include "core/check.hpp"
+#include "core/thread_name.hpp"
 #include "tools/dataset/input_error.hpp"
 
 namespace parallax {
@@ -32,6 +33,7 @@ FramePrefetcher::~FramePrefetcher() {
 }
 
 void FramePrefetcher::ReadAhead() {
+  NameThisThread("px-reader");
   for (;;) {
     {
       std::unique_lock<std::mutex> lock(mutex_);
