@@ -142,48 +142,46 @@ std::string TimestampText(double t) { return std::isfinite(t) ? FormatTimestamp(
 
 }  // namespace
 
-std::string EventNames(const std::vector<SystemEvent>& events) {
+namespace {
+
+std::string EventName(const SystemEvent& e) {
+  switch (e.kind) {
+    case SystemEvent::Kind::kKeyframeCreated:
+      return "keyframe";
+    case SystemEvent::Kind::kKeyframeFinished:
+      return "finished";
+    case SystemEvent::Kind::kGraphOptimised:
+      return "optimised";
+    case SystemEvent::Kind::kLost:
+      return "lost";
+    case SystemEvent::Kind::kRecovered:
+      return "recovered";
+    case SystemEvent::Kind::kPosesRevised:
+      return "revised";
+    case SystemEvent::Kind::kRestarted:
+      return "restarted";
+    case SystemEvent::Kind::kLoopClosed:
+      return "loop:" + std::to_string(e.loop_keyframe_id);
+    case SystemEvent::Kind::kRelocalised:
+      return "relocalised:" + std::to_string(e.keyframe_id);
+    case SystemEvent::Kind::kNewMap:
+      return "new_map:" + std::to_string(e.map_id);
+    case SystemEvent::Kind::kMapsMerged:
+      return "merged:" + std::to_string(e.map_id);
+    case SystemEvent::Kind::kDiverged:
+      return "diverged:" + std::to_string(e.keyframe_id);
+  }
+  return "unknown";
+}
+
+}  // namespace
+
+std::string EventNames(const std::vector<SystemEvent>& events, const FrameSuffix& other_frame) {
   std::string names;
   for (const SystemEvent& e : events) {
     if (!names.empty()) names += ';';
-    switch (e.kind) {
-      case SystemEvent::Kind::kKeyframeCreated:
-        names += "keyframe";
-        break;
-      case SystemEvent::Kind::kKeyframeFinished:
-        names += "finished";
-        break;
-      case SystemEvent::Kind::kGraphOptimised:
-        names += "optimised";
-        break;
-      case SystemEvent::Kind::kLost:
-        names += "lost";
-        break;
-      case SystemEvent::Kind::kRecovered:
-        names += "recovered";
-        break;
-      case SystemEvent::Kind::kPosesRevised:
-        names += "revised";
-        break;
-      case SystemEvent::Kind::kRestarted:
-        names += "restarted";
-        break;
-      case SystemEvent::Kind::kLoopClosed:
-        names += "loop:" + std::to_string(e.loop_keyframe_id);
-        break;
-      case SystemEvent::Kind::kRelocalised:
-        names += "relocalised:" + std::to_string(e.keyframe_id);
-        break;
-      case SystemEvent::Kind::kNewMap:
-        names += "new_map:" + std::to_string(e.map_id);
-        break;
-      case SystemEvent::Kind::kMapsMerged:
-        names += "merged:" + std::to_string(e.map_id);
-        break;
-      case SystemEvent::Kind::kDiverged:
-        names += "diverged:" + std::to_string(e.keyframe_id);
-        break;
-    }
+    names += EventName(e);
+    if (other_frame) names += other_frame(e.frame_id);
   }
   return names;
 }
@@ -209,12 +207,19 @@ std::string RunOutputs::Path(const std::string& name) const {
   return (fs::path(out_dir_) / name).string();
 }
 
-void RunOutputs::LogFrame(int index, double timestamp, const FrameResult& result) {
+void RunOutputs::LogFrame(int index, double timestamp, std::int64_t frame_id,
+                          const FrameResult& result) {
+  index_of_frame_[frame_id] = index;
+  const auto other_frame = [&](std::int64_t id) -> std::string {
+    if (id == frame_id) return "";
+    const auto known = index_of_frame_.find(id);
+    return known == index_of_frame_.end() ? "" : "@" + std::to_string(known->second);
+  };
   frame_log_ << fmt::format(
       "{},{},{},{},{},{:.3f},{:.3f},{}\n", index, TimestampText(timestamp),
       result.answered_before_mapping ? "initialising" : ToString(result.status),
       result.T_w_c ? 1 : 0, result.is_keyframe ? 1 : 0, result.tracking_ms, result.mapping_ms,
-      EventNames(result.events));
+      EventNames(result.events, other_frame));
   frame_log_.flush();
   if (!result.T_w_c) return;
   const Trajectory one{{timestamp, *result.T_w_c}};

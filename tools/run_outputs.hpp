@@ -4,8 +4,11 @@
 // final files written atomically (temporary file + rename) with a manifest, run.json, that
 // says whether the run completed, was interrupted or failed.
 
+#include <cstdint>
 #include <fstream>
+#include <functional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "backend/system.hpp"
@@ -14,8 +17,13 @@
 
 namespace parallax {
 
-/// Events in frames.csv's notation: `finished;optimised;loop:<keyframe id>;...`.
-std::string EventNames(const std::vector<SystemEvent>& events);
+/// Events in frames.csv's notation: `finished;optimised;loop:<keyframe id>;...`. An event
+/// about another frame than the row's (the real-time mode reports what mapping did behind
+/// the caller with the caller's next frame) gets `@<that frame's index>` from `other_frame`,
+/// which returns "" for the row's own frame; without it nothing is appended.
+using FrameSuffix = std::function<std::string(std::int64_t frame_id)>;
+std::string EventNames(const std::vector<SystemEvent>& events,
+                       const FrameSuffix& other_frame = nullptr);
 
 class RunOutputs {
  public:
@@ -25,8 +33,9 @@ class RunOutputs {
              const std::string& dataset);
 
   /// One line of frames.csv and, for a posed frame, of trajectory_online.txt (both flushed,
-  /// so an interrupted or crashed run keeps them). `unreadable`: the reader's message.
-  void LogFrame(int index, double timestamp, const FrameResult& result);
+  /// so an interrupted or crashed run keeps them). `frame_id`: the engine's id of the frame
+  /// (System::NextFrameId() - 1 after it was processed).
+  void LogFrame(int index, double timestamp, std::int64_t frame_id, const FrameResult& result);
   void LogUnreadable(int index, double timestamp, const std::string& unreadable);
   /// A frame the live camera replaced before tracking took it (real-time mode).
   void LogDropped(int index, double timestamp);
@@ -44,7 +53,8 @@ class RunOutputs {
   RunOptions::TrajectoryFormat format_;
   std::ofstream frame_log_;
   std::ofstream online_;
-  std::ofstream online_times_;  ///< KITTI format only
+  std::ofstream online_times_;                            ///< KITTI format only
+  std::unordered_map<std::int64_t, int> index_of_frame_;  ///< the engine's frame id -> index
 };
 
 }  // namespace parallax

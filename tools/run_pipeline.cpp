@@ -178,7 +178,8 @@ RunSummary RunDataset(const RunOptions& options) {
       const auto call = StageClock::now();
       const FrameResult result = system.ProcessFrame(frame->image, frame->timestamp);
       timings.latency_ms.push_back(MillisecondsSince(call));
-      outputs.LogFrame(static_cast<int>(frame->index), frame->timestamp, result);
+      outputs.LogFrame(static_cast<int>(frame->index), frame->timestamp, system.NextFrameId() - 1,
+                       result);
       timings.tracking_ms.push_back(result.tracking_ms);
       timings.mapping_ms.push_back(result.mapping_ms);
       if (options.progress && !summary.realtime) {

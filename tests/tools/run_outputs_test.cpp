@@ -170,5 +170,31 @@ TEST_F(RunOutputsTest, AnUnusableOutputFolderFailsBeforeTheFirstFrame) {
   }
 }
 
+TEST_F(RunOutputsTest, EventsAboutAnEarlierFrameNameItsIndex) {
+  // The real-time mode reports what mapping did behind the caller with a later frame: the
+  // frame log says which frame an event is about when it is not the row's.
+  const std::string out = dir_->File("events_out");
+  FrameResult later;
+  later.events.push_back({SystemEvent::Kind::kKeyframeCreated, 1, 1});
+  later.events.push_back({SystemEvent::Kind::kLost, 2, -1});
+  {
+    RunOutputs outputs(out, RunOptions::TrajectoryFormat::kTum, dir_->File("room"));
+    FrameResult first;
+    first.events.push_back({SystemEvent::Kind::kLost, 0, -1});
+    outputs.LogFrame(10, 1.0, 0, first);  // dataset index 10 is the engine's frame 0
+    outputs.LogFrame(11, 1.1, 1, FrameResult{});
+    outputs.LogFrame(12, 1.2, 2, later);
+  }
+  std::ifstream log(out + "/frames.csv");
+  std::vector<std::string> events;
+  for (std::string line; std::getline(log, line);)
+    events.push_back(line.substr(line.rfind(',') + 1));
+  ASSERT_EQ(events.size(), 4u);
+  EXPECT_EQ(events[1], "lost");
+  EXPECT_EQ(events[2], "");
+  EXPECT_EQ(events[3], "keyframe@11;lost");
+  EXPECT_EQ(EventNames(later.events), "keyframe;lost");  // no frame names without a lookup
+}
+
 }  // namespace
 }  // namespace parallax
