@@ -1,13 +1,15 @@
 // Place recognition costs: ORB extraction, vocabulary lookup per keyframe, a database query
-// at 1,000 keyframes, ORB matching by nodes and Sim(3) RANSAC (the geometric part of loop
-// verification; its direct alignments are Sim3 tracker runs, see tracking_benchmark).
+// at 1,000 keyframes, ORB matching by nodes, Sim(3) RANSAC, and a whole loop closure of a
+// true revisit (query, verification, loop edge and optimisation).
 
 #include <benchmark/benchmark.h>
 
 #include <random>
 
+#include "backend/loop_closer.hpp"
 #include "backend/place_recognizer.hpp"
 #include "backend/sim3_ransac.hpp"
+#include "tests/backend/revisit_fixture.hpp"
 #include "tests/tracking/render_fixture.hpp"
 #include "tools/synth/motion.hpp"
 #include "tools/synth/scene.hpp"
@@ -84,6 +86,29 @@ void BM_Sim3Ransac200Matches40PercentOutliers(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(EstimateSim3Ransac(matches, camera, {}));
 }
 BENCHMARK(BM_Sim3Ransac200Matches40PercentOutliers)->Unit(benchmark::kMillisecond);
+
+/// LoopCloser::KeyframeFinished on a 13-keyframe orbit graph whose last keyframe revisits
+/// the first (tests/backend/revisit_fixture.hpp): the database query, the verification of
+/// the candidate (ORB matches lifted with both keyframes' depth, Sim(3) RANSAC, direct Sim(3)
+/// alignment both ways, which rebuilds both compacted keyframes' pyramids and tracking
+/// references), the loop edge and the graph's optimisation. The consistency gate is set to
+/// one keyframe (it is bookkeeping); the graph is copied outside the timing.
+void BM_LoopClosureOfATrueRevisit(benchmark::State& state) {
+  const SystemOptions options;
+  const test::Revisit revisit = test::MakeRevisit(options);
+  GraphBackend backend(options.backend, revisit.build);
+  LoopClosureOptions loop = options.loop_closure;
+  loop.consistency = 1;
+  for (auto _ : state) {
+    state.PauseTiming();
+    KeyframeGraph graph = revisit.graph;
+    LoopCloser closer(loop, revisit.recognizer.get(), revisit.build.camera);
+    state.ResumeTiming();
+    const LoopReport report = closer.KeyframeFinished(&graph, &backend, revisit.revisit_id);
+    if (!report.loop_keyframe) state.SkipWithError("the revisit was not closed");
+  }
+}
+BENCHMARK(BM_LoopClosureOfATrueRevisit)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace parallax
