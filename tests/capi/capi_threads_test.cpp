@@ -20,6 +20,7 @@ namespace {
 std::vector<ImageU8> OrbitImages(int count) {
   static const synth::Scene scene = synth::MakeScene("room", 1);
   std::vector<ImageU8> images;
+  images.reserve(static_cast<std::size_t>(count));
   for (int k = 0; k < count; ++k) {
     images.push_back(test::RenderTestImage(
         scene, synth::CameraPose(synth::Motion::kOrbit, scene.rig, k / 30.0, 5.0)));
