@@ -140,10 +140,6 @@ void WriteStats(const std::string& path, const RunSummary& s) {
 
 std::string TimestampText(double t) { return std::isfinite(t) ? FormatTimestamp(t) : "nan"; }
 
-}  // namespace
-
-namespace {
-
 std::string EventName(const SystemEvent& e) {
   switch (e.kind) {
     case SystemEvent::Kind::kKeyframeCreated:
@@ -210,6 +206,9 @@ std::string RunOutputs::Path(const std::string& name) const {
 void RunOutputs::LogFrame(int index, double timestamp, std::int64_t frame_id,
                           const FrameResult& result) {
   index_of_frame_[frame_id] = index;
+  // Events concern the frames mapping has not passed yet (a few dozen behind at most); the
+  // engine's ids of successive calls are consecutive, so the oldest one kept goes.
+  index_of_frame_.erase(frame_id - kFramesRemembered);
   const auto other_frame = [&](std::int64_t id) -> std::string {
     if (id == frame_id) return "";
     const auto known = index_of_frame_.find(id);

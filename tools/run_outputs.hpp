@@ -53,8 +53,10 @@ class RunOutputs {
   RunOptions::TrajectoryFormat format_;
   std::ofstream frame_log_;
   std::ofstream online_;
-  std::ofstream online_times_;                            ///< KITTI format only
-  std::unordered_map<std::int64_t, int> index_of_frame_;  ///< the engine's frame id -> index
+  std::ofstream online_times_;  ///< KITTI format only
+  /// The engine's frame id -> dataset index, for the last kFramesRemembered frames.
+  static constexpr std::int64_t kFramesRemembered = 4096;
+  std::unordered_map<std::int64_t, int> index_of_frame_;
 };
 
 }  // namespace parallax
