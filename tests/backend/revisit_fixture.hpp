@@ -25,7 +25,7 @@ struct Revisit {
 };
 
 /// The first keyframe's pose is exact; keyframe k is off by k times a small rotation,
-/// translation and scale step (about 1.5 degrees, 8 cm and 2.4% at the revisit).
+/// translation and scale step (about 1.4 degrees, 8 cm and 2.4% at the revisit).
 inline Revisit MakeRevisit(const SystemOptions& options, int chain = 12) {
   static const synth::Scene scene = synth::MakeScene("room", 5);
   Revisit r;
