@@ -164,6 +164,23 @@ TEST(Evaluation, DegenerateInputsGiveClearErrors) {
   EXPECT_NEAR(Evaluate(line_est, line_gt, none).ate.max, std::hypot(0.9, 1.8), 1e-12);
 }
 
+TEST(Evaluation, TheWorstPoseIsNamedWithItsShareOfThePath) {
+  // One pose of an exact trajectory pushed off by 0.2 m: without alignment it is the worst,
+  // at its own time, and its error is measured against the matched ground-truth path.
+  const Pair p = MakePair(Sim3d(), 0.0, 1);
+  Trajectory estimate = p.estimate;
+  estimate[40].T_w_c = SE3d(estimate[40].T_w_c.Rotation(),
+                            estimate[40].T_w_c.Translation() + Eigen::Vector3d(0.2, 0, 0));
+  EvaluationOptions none;
+  none.alignment = AlignmentMode::kNone;
+  const EvaluationReport r = Evaluate(estimate, p.groundtruth, none);
+  EXPECT_NEAR(r.ate.max, 0.2, 1e-9);
+  EXPECT_DOUBLE_EQ(r.ate_max_timestamp, estimate[40].timestamp);
+  EXPECT_NEAR(r.ate_max_percent_of_path, 100.0 * 0.2 / r.groundtruth_path_length, 1e-9);
+  EXPECT_NE(FormatReport(r).find("worst pose"), std::string::npos);
+  EXPECT_NE(ReportToJson(r).find("ate_max_percent_of_path"), std::string::npos);
+}
+
 TEST(Evaluation, StraightTrajectoryIsAlignedWithTheOrientations) {
   // A camera sliding along a line while it turns (the rendered "rotate" motion): the
   // positions fix scale, translation and the line; the orientations fix the turn about it.

@@ -161,8 +161,11 @@ EvaluationReport Evaluate(const Trajectory& estimate, const Trajectory& groundtr
     }
   }
   report.ate = ComputeStatistics(ate);
+  report.ate_max_timestamp =
+      times[static_cast<std::size_t>(std::max_element(ate.begin(), ate.end()) - ate.begin())];
   if (report.groundtruth_path_length > 0.0) {
     report.ate_rmse_percent_of_path = report.ate.rmse / report.groundtruth_path_length * 100.0;
+    report.ate_max_percent_of_path = report.ate.max / report.groundtruth_path_length * 100.0;
   }
   std::vector<std::pair<std::size_t, std::size_t>> per_frame, per_second;
   for (std::size_t i = 0; i + 1 < est.size(); ++i) per_frame.emplace_back(i, i + 1);
@@ -204,6 +207,8 @@ std::string FormatReport(const EvaluationReport& r) {
                    r.ate.mean, r.ate.median, r.ate.max);
   s += fmt::format("path         {:.4f} (ground truth); ATE rmse = {:.3f}% of path\n",
                    r.groundtruth_path_length, r.ate_rmse_percent_of_path);
+  s += fmt::format("worst pose   t = {}: {:.6f} = {:.3f}% of path\n", r.ate_max_timestamp,
+                   r.ate.max, r.ate_max_percent_of_path);
   const auto rpe = [&](const char* name, const RelativePoseError& e) {
     s += fmt::format("{} trans rmse {:.6f} mean {:.6f}  rot rmse {:.4f} deg  ({} pairs)\n", name,
                      e.translation.rmse, e.translation.mean, e.rotation_deg.rmse,
@@ -259,6 +264,8 @@ std::string ReportToJson(const EvaluationReport& r) {
                             {"ate", stats(r.ate)},
                             {"groundtruth_path_length", r.groundtruth_path_length},
                             {"ate_rmse_percent_of_path", r.ate_rmse_percent_of_path},
+                            {"ate_max_timestamp", r.ate_max_timestamp},
+                            {"ate_max_percent_of_path", r.ate_max_percent_of_path},
                             {"rpe_per_frame",
                              {{"translation", stats(r.rpe_per_frame.translation)},
                               {"rotation_deg", stats(r.rpe_per_frame.rotation_deg)}}},

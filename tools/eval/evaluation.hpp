@@ -74,8 +74,10 @@ struct EvaluationReport {
   std::size_t frames_with_pose = 0;      ///< image frames with an estimated pose
   Sim3d S_gt_est;                        ///< alignment applied to the estimate
   ErrorStatistics ate;                   ///< absolute trajectory error of positions after alignment
+  double ate_max_timestamp = 0.0;        ///< the estimate's pose with the largest ATE (ate.max)
   double groundtruth_path_length = 0.0;  ///< along the matched ground-truth poses
   double ate_rmse_percent_of_path = 0.0;
+  double ate_max_percent_of_path = 0.0;  ///< the worst pose's error (issue 15's per-frame bound)
   RelativePoseError rpe_per_frame;       ///< consecutive matched poses
   RelativePoseError rpe_per_second;      ///< pairs rpe_delta_seconds apart
   double rpe_delta_meters = 0.0;         ///< the step actually used
