@@ -12,6 +12,7 @@
 
 #include "backend/frame_tracker.hpp"
 #include "core/sim3.hpp"
+#include "depth/parallax_moments.hpp"
 #include "tracking/tracking_reference.hpp"
 
 namespace parallax {
@@ -31,7 +32,8 @@ struct LiveSnapshot {
   /// World poses of the newest finished keyframes (taken with S_w_kf), so that the live
   /// state can follow over several keyframe changes it did not see.
   std::vector<std::pair<std::int64_t, Sim3d>> recent_poses;
-  double mean_idepth = 1.0;      ///< of the current keyframe (keyframe distance rule)
+  /// Of the current keyframe's depth (the keyframe rule's distance).
+  ParallaxMoments parallax{1.0, 1.0, 0.0, 0.0, 0.0};
   std::uint64_t generation = 0;  ///< System::map_generation_
 };
 

@@ -68,6 +68,12 @@ void SystemOptions::Check() const {
               "early_keyframe_usage", "must be in [0, 1) (0 disables)");
 }
 
+double SystemOptions::KeyframeDistance(const ParallaxMoments& parallax,
+                                       const Eigen::Vector3d& t_kf_frame) const {
+  return keyframe_distance_in_image ? parallax.ImageDistance(t_kf_frame)
+                                    : t_kf_frame.norm() * parallax.mean_idepth;
+}
+
 bool SystemOptions::WantsKeyframe(int frames_in_keyframe, double relative_distance,
                                   const TrackingStats& stats) const {
   const bool view_degrades =
@@ -309,16 +315,19 @@ TrackingResult System::TrackFrame(const Frame& frame, FrameResult* result) {
 void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
                       const TrackingResult& tracked, FrameResult* result) {
   const auto start = Clock::now();
-  // Distance relative to the mean depth (mean idepth is 1 after normalisation).
-  const double relative_distance =
-      tracked.T_kf_frame.Translation().norm() * mapper_.Map().MeanSmoothedIdepth();
+  // Distance relative to the mean depth (mean idepth is 1 after normalisation): the depth
+  // updates' baseline, and (as the image sees it, by default) the keyframe rule's distance.
+  const ParallaxMoments parallax = ComputeParallaxMoments(mapper_.Map());
+  const Eigen::Vector3d& t_kf_frame = tracked.T_kf_frame.Translation();
+  const double relative_distance = t_kf_frame.norm() * parallax.mean_idepth;
   // While a two-view pair is sought or held the first keyframe stays: the random start it
   // would be compared with, or replaced by, lives in that keyframe.
   const bool start_pending =
       start_ == StartState::kRandomPairSearch || start_ == StartState::kRandomPairHeld;
   const bool want_keyframe =
       !start_pending &&
-      options_.WantsKeyframe(tracker_.State().frames_in_keyframe, relative_distance, tracked.stats);
+      options_.WantsKeyframe(tracker_.State().frames_in_keyframe,
+                             options_.KeyframeDistance(parallax, t_kf_frame), tracked.stats);
   if (tracked.status == TrackingStatus::kOk && relative_distance > options_.min_update_baseline) {
     // Only once initialised: the start's keyframe and its selection stay as they were.
     const bool initialised = start_ == StartState::kInitialised;

@@ -11,6 +11,7 @@
 #include "core/frame_quality.hpp"
 #include "core/image_pyramid.hpp"
 #include "depth/depth_options.hpp"
+#include "depth/parallax_moments.hpp"
 #include "tracking/se3_tracker.hpp"
 #include "tracking/tracking_reference.hpp"
 
@@ -110,6 +111,10 @@ struct SystemOptions {
   /// New keyframe when |t_kf_frame| * mean idepth (distance relative to the mean depth)
   /// exceeds this, or when fewer than `min_keyframe_usage` of the keyframe points are in view.
   double keyframe_distance = 0.15;
+  /// The distance of that rule as the image sees it (ParallaxMoments::ImageDistance): a
+  /// translation along the optical axis counts by how far it moves the keyframe's points,
+  /// as DSO's translational-flow rule does (docs/math/keyframe_rule.md); false: |t| E[rho].
+  bool keyframe_distance_in_image = false;
   double min_keyframe_usage = 0.6;
   /// ... or when the share of consistent points falls below this (the view has changed
   /// enough that the keyframe explains it worse; DSO uses a residual-growth rule alike).
@@ -189,8 +194,11 @@ struct SystemOptions {
 
   void Check() const;
 
+  /// The keyframe rule's distance of a frame at `t_kf_frame` (keyframe coordinates) from a
+  /// keyframe whose depth has moments `parallax` (see keyframe_distance_in_image).
+  double KeyframeDistance(const ParallaxMoments& parallax, const Eigen::Vector3d& t_kf_frame) const;
   /// The keyframe rule (both modes): whether a frame tracked `frames_in_keyframe` frames
-  /// into its keyframe, at `relative_distance` (|t_kf_frame| times the mean inverse depth),
+  /// into its keyframe, at `relative_distance` (KeyframeDistance),
   /// with tracking statistics `stats`, should become the next keyframe.
   bool WantsKeyframe(int frames_in_keyframe, double relative_distance,
                      const TrackingStats& stats) const;

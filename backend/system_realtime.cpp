@@ -221,7 +221,8 @@ System::LiveStep System::TrackLive(const Frame& frame, const LiveSnapshot& snaps
   // still tracks (the rule fires well before the view is lost), and follows the new one
   // when it is published.
   const TrackingResult& t = step.tracked;
-  const double relative_distance = t.T_kf_frame.Translation().norm() * snapshot.mean_idepth;
+  const double relative_distance =
+      options_.KeyframeDistance(snapshot.parallax, t.T_kf_frame.Translation());
   const bool wants_keyframe =
       snapshot.initialised &&
       options_.WantsKeyframe(live_->tracker.State().frames_in_keyframe, relative_distance, t.stats);
@@ -353,7 +354,7 @@ void System::PublishLive() {
     s.keyframe_id = current_.id;
     s.reference = mapper_.Reference();
     s.S_w_kf = CurrentKeyframePose();
-    s.mean_idepth = mapper_.Map().MeanSmoothedIdepth();
+    s.parallax = ComputeParallaxMoments(mapper_.Map());
     if (s.keyframe_id != live_->published_keyframe_id) {
       live_->published_previous_id = live_->published_keyframe_id;
       live_->published_keyframe_id = s.keyframe_id;

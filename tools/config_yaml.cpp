@@ -86,6 +86,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"bootstrap_min_twin_cost_ratio", Set(&o->bootstrap.min_twin_cost_ratio)},
         {"bootstrap_max_offset_sigma", Set(&o->bootstrap.max_offset_sigma)},
         {"keyframe_distance", Set(&o->keyframe_distance)},
+        {"keyframe_distance_in_image", Set(&o->keyframe_distance_in_image)},
         {"min_keyframe_usage", Set(&o->min_keyframe_usage)},
         {"min_keyframe_good_ratio", Set(&o->min_keyframe_good_ratio)},
         {"min_update_baseline", Set(&o->min_update_baseline)},
