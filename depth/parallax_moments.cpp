@@ -27,6 +27,7 @@ ParallaxMoments ComputeParallaxMoments(const InverseDepthMap& map) {
   // Per row: count, sum rho, sum rho^2, sum rho^2 x, sum rho^2 y, sum rho^2 r^2.
   using RowSums = std::array<double, 6>;
   std::vector<RowSums> rows(static_cast<std::size_t>(height), RowSums{});
+  const double inv_fx = 1.0 / camera.Fx();
   tbb::parallel_for(0, height, [&](int v) {
     const double y = (v - camera.Cy()) / camera.Fy();
     RowSums s{};
@@ -34,7 +35,7 @@ ParallaxMoments ComputeParallaxMoments(const InverseDepthMap& map) {
     for (int u = 0; u < width; ++u) {
       const std::size_t i = row + static_cast<std::size_t>(u);
       if (!map.valid[i]) continue;
-      const double x = (u - camera.Cx()) / camera.Fx();
+      const double x = (u - camera.Cx()) * inv_fx;
       const double rho = map.idepth_smoothed[i];
       const double rho2 = rho * rho;
       s[0] += 1.0;
