@@ -316,7 +316,8 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& 
                       const TrackingResult& tracked, FrameResult* result) {
   const auto start = Clock::now();
   // Distance relative to the mean depth (mean idepth is 1 after normalisation): the depth
-  // updates' baseline, and (as the image sees it, by default) the keyframe rule's distance.
+  // updates' baseline, and the keyframe rule's distance (or, with keyframe_distance_in_image,
+  // that distance as the image sees it).
   const ParallaxMoments parallax = ComputeParallaxMoments(mapper_.Map());
   const Eigen::Vector3d& t_kf_frame = tracked.T_kf_frame.Translation();
   const double relative_distance = t_kf_frame.norm() * parallax.mean_idepth;
