@@ -137,6 +137,62 @@ TEST(BenchRunner, RepeatsOfADeterministicRunAreIdentical) {
   EXPECT_TRUE(r.runs[0].repeats_identical);
 }
 
+// first_frames: one sequence per start, each run with --first-frame and judged on the frames
+// from its start only (the skipped ones count neither as posed nor as missed).
+TEST(BenchRunner, FirstFramesRunOneSequencePerStartJudgedFromItsStart) {
+  const TempDir dir;
+  const std::string suite =
+      dir.Write("starts.yaml",
+                "sequences:\n  - name: room\n    first_frames: [0, 12]\n"
+                "    synth: {scene: room, motion: shake, frames: 40, width: 320, height: 240}\n");
+  const Suite parsed = ReadSuite(suite, dir.File("cache"));
+  ASSERT_EQ(parsed.sequences.size(), 2u);
+  EXPECT_EQ(parsed.sequences[0].name, "room@0");
+  EXPECT_EQ(parsed.sequences[1].name, "room@12");
+  EXPECT_EQ(parsed.sequences[1].first_frame, 12);
+  EXPECT_EQ(parsed.sequences[0].path, parsed.sequences[1].path);  // rendered once
+  const BenchResult r = RunBench(suite, Options(dir, "out", 2));
+  ASSERT_EQ(r.runs.size(), 2u);
+  const RunRecord& late = r.runs[1];
+  ASSERT_TRUE(late.Ok()) << late.log_tail << late.figures.error;
+  EXPECT_NE(late.command.find("--first-frame 12"), std::string::npos) << late.command;
+  EXPECT_EQ(r.runs[0].command.find("--first-frame"), std::string::npos);
+  EXPECT_GT(late.frames_tracked, 20);
+  EXPECT_DOUBLE_EQ(late.figures.coverage, static_cast<double>(late.frames_tracked) / 28.0);
+  const Trajectory estimate = ReadTrajectoryFile({late.figures.estimate, "", ""});
+  const Trajectory gt = ReadDatasetGroundTruth(late.groundtruth).poses;
+  ASSERT_FALSE(estimate.empty());
+  EXPECT_GE(estimate.front().timestamp, gt[12].timestamp - 1e-9);
+  const nlohmann::json j = nlohmann::json::parse(ReportJson(r, "test"));
+  EXPECT_EQ(j["sequences"][1]["first_frame"], 12);
+  // Errors name the line: a start beyond the frames, a start with a peer's trajectory.
+  const auto expect_line = [&](const std::string& text, int line, const std::string& fragment) {
+    try {
+      ReadSuite(dir.Write("bad.yaml", text), dir.File("cache"));
+      ADD_FAILURE() << text;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.Line(), line) << e.what();
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+  };
+  dir.Write("data/seq/rgb.txt", "");
+  dir.Write("data/peer.txt", "");
+  expect_line(
+      "sequences:\n  - name: a\n    path: data/seq\n    max_frames: 10\n"
+      "    first_frames: [2, 10]\n",
+      5, "below max_frames");
+  expect_line("sequences:\n  - name: a\n    path: data/seq\n    first_frames: [x]\n", 4,
+              "integers");
+  expect_line(
+      "sequences:\n  - name: a\n    path: data/seq\n    first_frames: [1]\n"
+      "    peers: {dso: data/peer.txt}\n",
+      4, "peers");
+  expect_line(
+      "sequences:\n  - {name: a@1, path: data/seq}\n"
+      "  - {name: a, path: data/seq, first_frames: [1]}\n",
+      3, "duplicate");
+}
+
 TEST(BenchRunner, PeersAreEvaluatedLikeTheRun) {
   const TempDir dir;
   // The peer is the ground truth itself: zero error, full coverage.

@@ -30,6 +30,9 @@ std::vector<std::string> RunArguments(const std::string& binary, const SequenceS
     argv.insert(argv.end(), {"--realtime", "--rate", std::to_string(*c.realtime_rate)});
   }
   if (s.max_frames > 0) argv.insert(argv.end(), {"--max-frames", std::to_string(s.max_frames)});
+  if (s.first_frame > 0) {
+    argv.insert(argv.end(), {"--first-frame", std::to_string(s.first_frame)});
+  }
   return argv;
 }
 
@@ -113,6 +116,12 @@ TrajectoryFigures EvaluateTrajectory(const std::string& estimate_file, const Seq
         options.frame_timestamps.size() > static_cast<std::size_t>(sequence.max_frames)) {
       options.frame_timestamps.resize(static_cast<std::size_t>(sequence.max_frames));
     }
+    // The frames before the start are not the run's: they count neither as posed nor missed.
+    const auto skipped =
+        std::min(options.frame_timestamps.size(), static_cast<std::size_t>(sequence.first_frame));
+    options.frame_timestamps.erase(
+        options.frame_timestamps.begin(),
+        options.frame_timestamps.begin() + static_cast<std::ptrdiff_t>(skipped));
     const Trajectory estimate = ReadTrajectoryFile({estimate_file, "", ""});
     const EvaluationReport sim3 = Evaluate(estimate, groundtruth, options);
     options.alignment = AlignmentMode::kSE3;
@@ -136,11 +145,11 @@ TrajectoryFigures EvaluateTrajectory(const std::string& estimate_file, const Seq
 
 namespace {
 
-/// Image frames the runs see (the dataset's, cut at max_frames).
+/// Image frames the runs see (the dataset's from first_frame, cut at max_frames).
 std::size_t SequenceFrames(const SequenceSpec& s) {
   std::size_t n = OpenDataset(s.path)->FrameTimestamps().size();
   if (s.max_frames > 0) n = std::min(n, static_cast<std::size_t>(s.max_frames));
-  return n;
+  return n - std::min(n, static_cast<std::size_t>(s.first_frame));
 }
 
 /// A job of the run list: which record (or peer of it) it belongs to.

@@ -153,6 +153,7 @@ std::string ReportJson(const BenchResult& result, const std::string& invocation)
                          {"format", s.format},
                          {"config", s.config},
                          {"max_frames", s.max_frames},
+                         {"first_frame", s.first_frame},
                          {"rendered", s.synth.has_value()},
                          {"tolerance",
                           {{"ate_relative", s.tolerance.ate_relative},

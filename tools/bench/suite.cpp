@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <set>
+#include <vector>
 
 #include "tools/dataset/input_error.hpp"
 
@@ -77,6 +78,34 @@ class Reader {
     return o;
   }
 
+  /// The sequence once per entry of `first_frames` (named NAME@k), or once as it is.
+  std::vector<SequenceSpec> Starts(const YAML::Node& node, const SequenceSpec& s) const {
+    const YAML::Node list = node["first_frames"];
+    if (!list) return {s};
+    if (!list.IsSequence() || list.size() == 0) {
+      Fail(list, "'first_frames' must be a non-empty list of frame indices");
+    }
+    // A peer program is given the dataset and a frame count only, not a start.
+    if (!s.peers.empty()) Fail(list, "'first_frames' cannot be combined with 'peers'");
+    std::vector<SequenceSpec> starts;
+    for (const YAML::Node& entry : list) {
+      int k = -1;
+      try {
+        k = entry.as<int>();
+      } catch (const YAML::Exception&) {
+        Fail(entry, "'first_frames' entries must be integers");
+      }
+      if (k < 0 || (s.max_frames > 0 && k >= s.max_frames)) {
+        Fail(entry, "a first frame must be >= 0 and below max_frames");
+      }
+      SequenceSpec start = s;
+      start.first_frame = k;
+      start.name = fmt::format("{}@{}", s.name, k);
+      starts.push_back(std::move(start));
+    }
+    return starts;
+  }
+
   Tolerance TolerancesOf(const YAML::Node& node) const {
     Tolerance t;
     if (!node) return t;
@@ -128,11 +157,10 @@ Suite ReadSuite(const std::string& file, const std::string& cache_dir) {
   std::set<std::string> names;
   for (const YAML::Node& node : sequences) {
     r.CheckKeys(node, {"name", "path", "synth", "format", "calibration", "groundtruth", "config",
-                       "max_frames", "tolerance", "peers"});
+                       "max_frames", "first_frames", "tolerance", "peers"});
     SequenceSpec s;
     s.name = r.Get<std::string>(node, "name", "");
     if (s.name.empty()) r.Fail(node, "a sequence needs a 'name'");
-    if (!names.insert(s.name).second) r.Fail(node["name"], "duplicate sequence '" + s.name + "'");
     if (node["synth"] && node["path"]) r.Fail(node, "give 'path' or 'synth', not both");
     if (node["synth"]) {
       s.synth = r.Synth(node["synth"]);
@@ -156,7 +184,12 @@ Suite ReadSuite(const std::string& file, const std::string& cache_dir) {
         s.peers[peer.first.as<std::string>()] = r.PathOf(holder, "p", false);
       }
     }
-    suite.sequences.push_back(std::move(s));
+    for (SequenceSpec& start : r.Starts(node, s)) {
+      if (!names.insert(start.name).second) {
+        r.Fail(node["name"], "duplicate sequence '" + start.name + "'");
+      }
+      suite.sequences.push_back(std::move(start));
+    }
   }
   if (const YAML::Node configurations = root["configurations"]) {
     std::set<std::string> config_names;

@@ -22,10 +22,15 @@ struct SequenceSpec {
   std::string name;
   std::string path;  ///< dataset folder (absolute); for rendered ones, the cache folder
   std::string format = "auto";
-  std::string calibration;                   ///< calibration YAML, optional
-  std::string groundtruth;                   ///< file or folder; empty: the dataset's own
-  std::string config;                        ///< options YAML for parallax run, optional
-  int max_frames = 0;                        ///< first N frames (0: all)
+  std::string calibration;  ///< calibration YAML, optional
+  std::string groundtruth;  ///< file or folder; empty: the dataset's own
+  std::string config;       ///< options YAML for parallax run, optional
+  int max_frames = 0;       ///< first N frames (0: all)
+  /// Frames before this dataset index are skipped (`parallax run --first-frame`): the same
+  /// sequence started at another frame, for changes whose effect depends on where the
+  /// keyframes fall (docs/benchmarks.md, "The harness"). A suite's `first_frames: [a, b]`
+  /// makes one sequence per start, named `NAME@a`, `NAME@b`.
+  int first_frame = 0;
   std::optional<synth::SynthOptions> synth;  ///< rendered on the fly when set
   Tolerance tolerance;
   std::map<std::string, std::string> peers;  ///< name -> another system's trajectory file
