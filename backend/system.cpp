@@ -7,6 +7,7 @@
 #include "backend/backend_worker.hpp"
 #include "backend/live_tracker.hpp"
 #include "backend/mapping_worker.hpp"
+#include "core/angles.hpp"
 #include "core/check.hpp"
 #include "core/divergence.hpp"
 #include "core/stopwatch.hpp"
@@ -51,6 +52,8 @@ void SystemOptions::Check() const {
   CheckOption(max_start_exposure_change > 1.0 && std::isfinite(max_start_exposure_change),
               "SystemOptions", "max_start_exposure_change", "must be > 1 and finite");
   CheckOption(keyframe_distance > 0.0, "SystemOptions", "keyframe_distance", "must be > 0");
+  CheckOption(keyframe_rotation_deg >= 0.0 && keyframe_rotation_deg < 180.0, "SystemOptions",
+              "keyframe_rotation_deg", "must be in [0, 180) (0 disables)");
   CheckOption(min_keyframe_usage >= 0.0 && min_keyframe_usage <= 1.0, "SystemOptions",
               "min_keyframe_usage", "must be in [0, 1]");
   CheckOption(min_update_baseline >= 0.0, "SystemOptions", "min_update_baseline", "must be >= 0");
@@ -68,21 +71,33 @@ void SystemOptions::Check() const {
               "early_keyframe_usage", "must be in [0, 1) (0 disables)");
 }
 
+ParallaxMoments SystemOptions::KeyframeMoments(const InverseDepthMap& map) const {
+  if (keyframe_distance_in_image) return ComputeParallaxMoments(map);
+  ParallaxMoments mean_only;
+  mean_only.mean_idepth = map.MeanSmoothedIdepth();
+  return mean_only;
+}
+
 double SystemOptions::KeyframeDistance(const ParallaxMoments& parallax,
                                        const Eigen::Vector3d& t_kf_frame) const {
   return keyframe_distance_in_image ? parallax.ImageDistance(t_kf_frame)
                                     : t_kf_frame.norm() * parallax.mean_idepth;
 }
 
+double SystemOptions::RotationDeg(const SE3d& T_kf_frame) {
+  return T_kf_frame.Rotation().Log().norm() * kRadToDeg;
+}
+
 bool SystemOptions::WantsKeyframe(int frames_in_keyframe, double relative_distance,
-                                  const TrackingStats& stats) const {
+                                  double rotation_deg, const TrackingStats& stats) const {
   const bool view_degrades =
       stats.usage < min_keyframe_usage || stats.good_ratio < min_keyframe_good_ratio;
   // Early only from a consistent frame: the view leaves the keyframe, the pose is sound.
   const bool soon_out_of_view =
       stats.usage < early_keyframe_usage && stats.good_ratio >= min_keyframe_good_ratio;
   return (frames_in_keyframe >= min_frames_per_keyframe || soon_out_of_view) &&
-         (view_degrades || relative_distance > keyframe_distance);
+         (view_degrades || relative_distance > keyframe_distance ||
+          (keyframe_rotation_deg > 0.0 && rotation_deg > keyframe_rotation_deg));
 }
 
 namespace {
@@ -318,7 +333,7 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& 
   // Distance relative to the mean depth (mean idepth is 1 after normalisation): the depth
   // updates' baseline, and the keyframe rule's distance (or, with keyframe_distance_in_image,
   // that distance as the image sees it).
-  const ParallaxMoments parallax = ComputeParallaxMoments(mapper_.Map());
+  const ParallaxMoments parallax = options_.KeyframeMoments(mapper_.Map());
   const Eigen::Vector3d& t_kf_frame = tracked.T_kf_frame.Translation();
   const double relative_distance = t_kf_frame.norm() * parallax.mean_idepth;
   // While a two-view pair is sought or held the first keyframe stays: the random start it
@@ -328,7 +343,8 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& 
   const bool want_keyframe =
       !start_pending &&
       options_.WantsKeyframe(tracker_.State().frames_in_keyframe,
-                             options_.KeyframeDistance(parallax, t_kf_frame), tracked.stats);
+                             options_.KeyframeDistance(parallax, t_kf_frame),
+                             SystemOptions::RotationDeg(tracked.T_kf_frame), tracked.stats);
   if (tracked.status == TrackingStatus::kOk && relative_distance > options_.min_update_baseline) {
     // Only once initialised: the start's keyframe and its selection stay as they were.
     const bool initialised = start_ == StartState::kInitialised;

@@ -115,6 +115,10 @@ struct SystemOptions {
   /// translation along the optical axis counts by how far it moves the keyframe's points,
   /// as DSO's translational-flow rule does (docs/math/keyframe_rule.md); false: |t| E[rho].
   bool keyframe_distance_in_image = false;
+  /// ... or when the frame has turned more than this from the keyframe (degrees; 0: off).
+  /// A rotation moves every point alike and is no distance for depth, but in a fast turn the
+  /// view leaves the keyframe within a few frames (docs/math/keyframe_rule.md, "Turns").
+  double keyframe_rotation_deg = 0.0;
   double min_keyframe_usage = 0.6;
   /// ... or when the share of consistent points falls below this (the view has changed
   /// enough that the keyframe explains it worse; DSO uses a residual-growth rule alike).
@@ -194,14 +198,21 @@ struct SystemOptions {
 
   void Check() const;
 
+  /// The moments of `map` that the keyframe rule and the depth updates' baseline read: all
+  /// of them with keyframe_distance_in_image, else only the mean inverse depth (the same
+  /// value, to the bit, without the position-weighted sums nothing reads).
+  ParallaxMoments KeyframeMoments(const InverseDepthMap& map) const;
   /// The keyframe rule's distance of a frame at `t_kf_frame` (keyframe coordinates) from a
   /// keyframe whose depth has moments `parallax` (see keyframe_distance_in_image).
   double KeyframeDistance(const ParallaxMoments& parallax, const Eigen::Vector3d& t_kf_frame) const;
   /// The keyframe rule (both modes): whether a frame tracked `frames_in_keyframe` frames
-  /// into its keyframe, at `relative_distance` (KeyframeDistance),
-  /// with tracking statistics `stats`, should become the next keyframe.
-  bool WantsKeyframe(int frames_in_keyframe, double relative_distance,
+  /// into its keyframe, at `relative_distance` (KeyframeDistance) and `rotation_deg` (the
+  /// angle of R_kf_frame, degrees), with tracking statistics `stats`, should become the next
+  /// keyframe.
+  bool WantsKeyframe(int frames_in_keyframe, double relative_distance, double rotation_deg,
                      const TrackingStats& stats) const;
+  /// The angle of `T_kf_frame`'s rotation, degrees (the rule's `rotation_deg`).
+  static double RotationDeg(const SE3d& T_kf_frame);
 };
 
 }  // namespace parallax

@@ -223,13 +223,16 @@ System::LiveStep System::TrackLive(const Frame& frame, const LiveSnapshot& snaps
   const TrackingResult& t = step.tracked;
   const double relative_distance =
       options_.KeyframeDistance(snapshot.parallax, t.T_kf_frame.Translation());
+  const double rotation_deg = SystemOptions::RotationDeg(t.T_kf_frame);
   const bool wants_keyframe =
-      snapshot.initialised &&
-      options_.WantsKeyframe(live_->tracker.State().frames_in_keyframe, relative_distance, t.stats);
+      snapshot.initialised && options_.WantsKeyframe(live_->tracker.State().frames_in_keyframe,
+                                                     relative_distance, rotation_deg, t.stats);
   step.keep = wants_keyframe && live_->keyframe_requested_in != snapshot.keyframe_id;
   const double f = options_.realtime.keyframe_wait_factor;
+  const double rotation_bound = options_.keyframe_rotation_deg;
   step.overdue = wants_keyframe && !step.keep &&
                  (relative_distance > f * options_.keyframe_distance ||
+                  (rotation_bound > 0.0 && rotation_deg > f * rotation_bound) ||
                   t.stats.usage * f < options_.min_keyframe_usage ||
                   t.stats.good_ratio * f < options_.min_keyframe_good_ratio);
   return step;
@@ -354,7 +357,7 @@ void System::PublishLive() {
     s.keyframe_id = current_.id;
     s.reference = mapper_.Reference();
     s.S_w_kf = CurrentKeyframePose();
-    s.parallax = ComputeParallaxMoments(mapper_.Map());
+    s.parallax = options_.KeyframeMoments(mapper_.Map());
     if (s.keyframe_id != live_->published_keyframe_id) {
       live_->published_previous_id = live_->published_keyframe_id;
       live_->published_keyframe_id = s.keyframe_id;

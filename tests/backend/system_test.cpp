@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/angles.hpp"
 #include "tests/tools/temp_dir.hpp"
 #include "tests/tracking/render_fixture.hpp"
 #include "tools/dataset/input_error.hpp"
@@ -160,21 +161,44 @@ TEST(SystemOptions, AKeyframeComesEarlyOnlyWhenAConsistentViewLeavesIt) {
   leaving.usage = 0.2;
   leaving.good_ratio = 0.95;
   const int second = options.min_frames_per_keyframe - 1;
-  EXPECT_TRUE(options.WantsKeyframe(second, 0.0, leaving));
+  EXPECT_TRUE(options.WantsKeyframe(second, 0.0, 0.0, leaving));
   TrackingStats degraded = leaving;  // degrades the view, but a third of it is still there
   degraded.usage = 0.5;
-  EXPECT_FALSE(options.WantsKeyframe(second, 0.0, degraded));
-  EXPECT_TRUE(options.WantsKeyframe(options.min_frames_per_keyframe, 0.0, degraded));
+  EXPECT_FALSE(options.WantsKeyframe(second, 0.0, 0.0, degraded));
+  EXPECT_TRUE(options.WantsKeyframe(options.min_frames_per_keyframe, 0.0, 0.0, degraded));
   TrackingStats inconsistent = leaving;  // the pose itself is in doubt: wait
   inconsistent.good_ratio = 0.6;
-  EXPECT_FALSE(options.WantsKeyframe(second, 0.0, inconsistent));
+  EXPECT_FALSE(options.WantsKeyframe(second, 0.0, 0.0, inconsistent));
   TrackingStats steady = leaving;  // a well-covered view far enough away: the usual rule
   steady.usage = 0.9;
-  EXPECT_FALSE(options.WantsKeyframe(second, 1.0, steady));
-  EXPECT_TRUE(options.WantsKeyframe(options.min_frames_per_keyframe, 1.0, steady));
+  EXPECT_FALSE(options.WantsKeyframe(second, 1.0, 0.0, steady));
+  EXPECT_TRUE(options.WantsKeyframe(options.min_frames_per_keyframe, 1.0, 0.0, steady));
   options.early_keyframe_usage = 0.0;
-  EXPECT_FALSE(options.WantsKeyframe(second, 0.0, leaving));
+  EXPECT_FALSE(options.WantsKeyframe(second, 0.0, 0.0, leaving));
   options.early_keyframe_usage = 1.0;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+}
+
+// The turn criterion: off by default; when set, a frame turned past it from its keyframe
+// wants a new one (after min_frames_per_keyframe), whatever its distance and view.
+TEST(SystemOptions, AFrameTurnedPastTheRotationBoundWantsAKeyframe) {
+  SystemOptions options;
+  TrackingStats steady;
+  steady.usage = 0.9;
+  steady.good_ratio = 0.95;
+  const int enough = options.min_frames_per_keyframe;
+  EXPECT_FALSE(
+      options.WantsKeyframe(enough, 0.0, 90.0, steady));  // off: a turn alone is no distance
+  options.keyframe_rotation_deg = 25.0;
+  EXPECT_FALSE(options.WantsKeyframe(enough, 0.0, 24.0, steady));
+  EXPECT_TRUE(options.WantsKeyframe(enough, 0.0, 26.0, steady));
+  EXPECT_FALSE(options.WantsKeyframe(enough - 1, 0.0, 26.0, steady));
+  // The angle of R_kf_frame, whichever its axis.
+  const SE3d turned(SO3d::Exp(Eigen::Vector3d(0.0, 30.0 / kRadToDeg, 0.0)),
+                    Eigen::Vector3d::Zero());
+  EXPECT_NEAR(SystemOptions::RotationDeg(turned), 30.0, 1e-9);
+  EXPECT_NEAR(SystemOptions::RotationDeg(turned.Inverse()), 30.0, 1e-9);
+  options.keyframe_rotation_deg = -1.0;
   EXPECT_THROW(options.Check(), std::invalid_argument);
 }
 
