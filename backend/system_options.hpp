@@ -114,11 +114,11 @@ struct SystemOptions {
   /// The distance of that rule as the image sees it (ParallaxMoments::ImageDistance): a
   /// translation along the optical axis counts by how far it moves the keyframe's points,
   /// as DSO's translational-flow rule does (docs/math/keyframe_rule.md); false: |t| E[rho].
-  bool keyframe_distance_in_image = false;
+  bool keyframe_distance_in_image = true;
   /// ... or when the frame has turned more than this from the keyframe (degrees; 0: off).
   /// A rotation moves every point alike and is no distance for depth, but in a fast turn the
   /// view leaves the keyframe within a few frames (docs/math/keyframe_rule.md, "Turns").
-  double keyframe_rotation_deg = 0.0;
+  double keyframe_rotation_deg = 30.0;
   double min_keyframe_usage = 0.6;
   /// ... or when the share of consistent points falls below this (the view has changed
   /// enough that the keyframe explains it worse; DSO uses a residual-growth rule alike).

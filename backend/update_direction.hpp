@@ -29,10 +29,11 @@ struct UpdateDirectionOptions {
   /// that neither view supports (docs/math/depth_filter.md, "Direction of the update pose").
   bool blend_rotation = true;
   /// The two directions must agree within this angle, degrees; otherwise tracking is kept.
-  /// Small corrections only: they stop the slow drift of the tracked direction, while the
-  /// essential matrix itself can be 5-10 degrees off on weak texture (docs/benchmarks.md has
-  /// the sensitivity: 2 degrees too few, 3-10 work on KITTI).
-  double max_angle_deg = 3.0;
+  /// Wide enough to catch the drift of forward motion between sparse keyframes, where the
+  /// tracked direction runs 4-11 degrees off within a few keyframes, narrow enough to refuse
+  /// an essential matrix that is far off on weak texture (docs/math/depth_filter.md, "The
+  /// gate's width").
+  double max_angle_deg = 9.0;
   /// ORB matching and essential-matrix RANSAC (800 features, half the bootstrap's: 15% faster
   /// end to end at the same accuracy; a pair needs 0.5 degrees of parallax on 30 points and 100
   /// inliers).

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 
+#include "tests/backend/scenario_options.hpp"
 #include "tests/tools/temp_dir.hpp"
 #include "tools/dataset/trajectory.hpp"
 #include "tools/eval/evaluation.hpp"
@@ -75,8 +76,9 @@ TEST(LoopClosure, AnOrbitEndingAtItsStartClosesTheLoopAtTheEndOfTheInput) {
   // Seed 4: only the last keyframe, never finished by a later one, sees the start well
   // enough twice in a row; FinishMapping puts it through the backend at the end. (With the
   // depth filter's pixel budget the loop closes before the end on this seed, 0.131% against
-  // 0.163% without: the scenario is kept with every estimate observed every update.)
-  SystemOptions system;
+  // 0.163% without: the scenario is kept with every estimate observed every update, and with
+  // the keyframe rule it was found with.)
+  SystemOptions system = test::WithRelativeKeyframeRule();
   system.depth.converged_relative_sigma = 0.0f;
   const test::TempDirAt dir("parallax_loop_orbit_end");
   synth::SynthOptions options;
@@ -101,7 +103,9 @@ TEST(LoopClosure, ALongCorridorWalkClosesNoFalseLoop) {
   // between places 7.6 m apart (the walk does not come back within 400 frames).
   const test::TempDirAt dir("parallax_loop_corridor");
   Render(dir, "corridor", "patrol", 400);
-  const LoopRun run = RunSequence(dir, "out", true);
+  // The keyframes of the rule this was measured with bring candidates to verification (with
+  // the image distance's sparser ones, none gets that far on this walk).
+  const LoopRun run = RunSequence(dir, "out", true, test::WithRelativeKeyframeRule());
   EXPECT_EQ(run.summary.loops_closed, 0);
   EXPECT_EQ(run.summary.edges.loop, 0);
   // The gates were exercised, not bypassed: candidates reached verification.

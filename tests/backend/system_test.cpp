@@ -179,16 +179,17 @@ TEST(SystemOptions, AKeyframeComesEarlyOnlyWhenAConsistentViewLeavesIt) {
   EXPECT_THROW(options.Check(), std::invalid_argument);
 }
 
-// The turn criterion: off by default; when set, a frame turned past it from its keyframe
-// wants a new one (after min_frames_per_keyframe), whatever its distance and view.
+// The turn criterion: a frame turned past it from its keyframe wants a new one (after
+// min_frames_per_keyframe), whatever its distance and view; 0 turns it off.
 TEST(SystemOptions, AFrameTurnedPastTheRotationBoundWantsAKeyframe) {
   SystemOptions options;
   TrackingStats steady;
   steady.usage = 0.9;
   steady.good_ratio = 0.95;
   const int enough = options.min_frames_per_keyframe;
-  EXPECT_FALSE(
-      options.WantsKeyframe(enough, 0.0, 90.0, steady));  // off: a turn alone is no distance
+  EXPECT_TRUE(options.WantsKeyframe(enough, 0.0, options.keyframe_rotation_deg + 1.0, steady));
+  options.keyframe_rotation_deg = 0.0;
+  EXPECT_FALSE(options.WantsKeyframe(enough, 0.0, 90.0, steady));  // off: a turn is no distance
   options.keyframe_rotation_deg = 25.0;
   EXPECT_FALSE(options.WantsKeyframe(enough, 0.0, 24.0, steady));
   EXPECT_TRUE(options.WantsKeyframe(enough, 0.0, 26.0, steady));

@@ -75,7 +75,7 @@ class UpdateDirectionTest : public test::RoomPairTest {
 // matrix's own direction (TwoViewBootstrapTest checks its accuracy) is found with the same
 // matcher; a tracked direction 2 degrees from it must come out halfway (weight 0.5) with the
 // tracked rotation and length, and be left alone for a short baseline, another keyframe, or a
-// tracked direction beyond the 3 degree gate.
+// tracked direction beyond the gate (max_angle_deg).
 TEST_F(UpdateDirectionTest, BlendsTheTrackedDirectionWithTheEssentialMatrix) {
   const SE3d T_true(SO3d::Exp(Eigen::Vector3d(0.0, 2.0 / kRadToDeg, 0.0)),
                     Eigen::Vector3d(0.20, 0.0, 0.05));
@@ -105,7 +105,7 @@ TEST_F(UpdateDirectionTest, BlendsTheTrackedDirectionWithTheEssentialMatrix) {
   const Eigen::Vector3d t = T_tracked.Translation();
   EXPECT_EQ(direction.Refine(3, frame, T_tracked, 0.01).Translation(), t);  // short baseline
   EXPECT_EQ(direction.Refine(4, frame, T_tracked, 0.1).Translation(), t);   // other keyframe
-  const SE3d far_off = tracked_at(5.0);
+  const SE3d far_off = tracked_at(every_update.max_angle_deg + 2.0);
   EXPECT_EQ(direction.Refine(3, frame, far_off, 0.1).Translation(), far_off.Translation());
   direction.Reset();
   EXPECT_EQ(direction.Refine(3, frame, T_tracked, 0.1).Translation(), t);
@@ -134,10 +134,10 @@ TEST_F(UpdateDirectionTest, ReusesTheLastCorrectionBetweenChecks) {
   EXPECT_NEAR(AngleBetweenDeg(reused, next.Translation()), 1.0, 0.01);
   EXPECT_NEAR(AngleBetweenDeg(reused, essential), 2.0, 0.01);
   EXPECT_NEAR(reused.norm(), 0.21, 1e-12);
-  // The baseline grew beyond 1.5x: checked again; 5 degrees is beyond the 3-degree gate.
-  const SE3d far_off = tracked_at(5.0);
+  // The baseline grew beyond 1.5x: checked again, beyond the gate.
+  const SE3d far_off = tracked_at(options.max_angle_deg + 2.0);
   EXPECT_EQ(direction.Refine(3, frame, far_off, 0.2).Translation(), far_off.Translation());
-  // The check left no correction; a direction 6 degrees from that one is checked again.
+  // The check left no correction; a direction far from that one is checked again.
   const SE3d back = tracked_at(-1.0);
   EXPECT_NEAR(
       AngleBetweenDeg(direction.Refine(3, frame, back, 0.2).Translation(), back.Translation()), 0.5,
@@ -196,7 +196,7 @@ TEST_F(UpdateDirectionTest, BlendsTheRotationWithTheDirection) {
   const SO3d correction = refined.Rotation() * tracked.Rotation().Inverse();
   EXPECT_LT(degrees(reused.Rotation(), correction * next.Rotation()), 1e-9);
   // Beyond the direction gate neither is touched.
-  const SE3d far_off = tracked_at(5.0);
+  const SE3d far_off = tracked_at(options.max_angle_deg + 2.0);
   const SE3d kept = direction.Refine(3, frame, far_off, 0.2);
   EXPECT_EQ(kept.Rotation().UnitQuaternion().coeffs(),
             far_off.Rotation().UnitQuaternion().coeffs());
