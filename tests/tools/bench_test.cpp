@@ -165,6 +165,10 @@ TEST(BenchRunner, FirstFramesRunOneSequencePerStartJudgedFromItsStart) {
   EXPECT_GE(estimate.front().timestamp, gt[12].timestamp - 1e-9);
   const nlohmann::json j = nlohmann::json::parse(ReportJson(r, "test"));
   EXPECT_EQ(j["sequences"][1]["first_frame"], 12);
+  // A peer program would run from frame 0: refused before anything runs.
+  BenchOptions with_peer = Options(dir, "peer", 1);
+  with_peer.peer_programs.push_back({"dso", "/bin/true"});
+  EXPECT_THROW(RunBench(suite, with_peer), std::invalid_argument);
   // Errors name the line: a start beyond the frames, a start with a peer's trajectory.
   const auto expect_line = [&](const std::string& text, int line, const std::string& fragment) {
     try {

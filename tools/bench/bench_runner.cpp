@@ -243,6 +243,11 @@ BenchResult RunBench(const std::string& suite_file, const BenchOptions& options)
                                 : options.cache_dir;
   BenchResult result;
   result.suite = ReadSuite(suite_file, cache);
+  for (const SequenceSpec& s : result.suite.sequences) {
+    // A peer program is given the dataset and a frame count, not a start.
+    CheckArgument(options.peer_programs.empty() || s.first_frame == 0,
+                  "bench: --peer cannot run '" + s.name + "' from its first_frames start");
+  }
   RenderMissing(result.suite, options.progress);
   JobList list;
   AddRuns(options, &result, &list);

@@ -85,7 +85,7 @@ class Reader {
     if (!list.IsSequence() || list.size() == 0) {
       Fail(list, "'first_frames' must be a non-empty list of frame indices");
     }
-    // A peer program is given the dataset and a frame count only, not a start.
+    // A peer's trajectory covers the whole sequence, not the run from a start.
     if (!s.peers.empty()) Fail(list, "'first_frames' cannot be combined with 'peers'");
     std::vector<SequenceSpec> starts;
     for (const YAML::Node& entry : list) {
