@@ -37,6 +37,18 @@ BenchOptions Options(const TempDir& dir, const std::string& out, int jobs) {
   return o;
 }
 
+// A suite `text` that ReadSuite refuses with an InputError naming `line` and `fragment`.
+void ExpectSuiteErrorAt(const TempDir& dir, const std::string& text, int line,
+                        const std::string& fragment) {
+  try {
+    ReadSuite(dir.Write("bad.yaml", text), dir.File("cache"));
+    ADD_FAILURE() << text;
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.Line(), line) << e.what();
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+  }
+}
+
 TEST(BenchSuite, MinimalSuiteAndErrorsWithLines) {
   const TempDir dir;
   dir.Write("data/seq/rgb.txt", "");
@@ -46,13 +58,7 @@ TEST(BenchSuite, MinimalSuiteAndErrorsWithLines) {
   EXPECT_EQ(s.sequences[0].path, std::filesystem::weakly_canonical(dir.File("data/seq")).string());
   EXPECT_EQ(s.configurations.size(), 1u);
   const auto expect_line = [&](const std::string& text, int line, const std::string& fragment) {
-    try {
-      ReadSuite(dir.Write("bad.yaml", text), dir.File("cache"));
-      ADD_FAILURE() << text;
-    } catch (const InputError& e) {
-      EXPECT_EQ(e.Line(), line) << e.what();
-      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-    }
+    ExpectSuiteErrorAt(dir, text, line, fragment);
   };
   expect_line("sequences:\n  - name: a\n    path: data/seq\n    colour: red\n", 4, "unknown key");
   expect_line("sequences:\n  - name: a\n    path: nowhere\n", 3, "does not exist");
@@ -171,13 +177,7 @@ TEST(BenchRunner, FirstFramesRunOneSequencePerStartJudgedFromItsStart) {
   EXPECT_THROW(RunBench(suite, with_peer), std::invalid_argument);
   // Errors name the line: a start beyond the frames, a start with a peer's trajectory.
   const auto expect_line = [&](const std::string& text, int line, const std::string& fragment) {
-    try {
-      ReadSuite(dir.Write("bad.yaml", text), dir.File("cache"));
-      ADD_FAILURE() << text;
-    } catch (const InputError& e) {
-      EXPECT_EQ(e.Line(), line) << e.what();
-      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-    }
+    ExpectSuiteErrorAt(dir, text, line, fragment);
   };
   dir.Write("data/seq/rgb.txt", "");
   dir.Write("data/peer.txt", "");
