@@ -54,6 +54,8 @@ void SystemOptions::Check() const {
   CheckOption(keyframe_distance > 0.0, "SystemOptions", "keyframe_distance", "must be > 0");
   CheckOption(keyframe_rotation_deg >= 0.0 && keyframe_rotation_deg < 180.0, "SystemOptions",
               "keyframe_rotation_deg", "must be in [0, 180) (0 disables)");
+  CheckOption(keyframe_rotation_min_rate_deg >= 0.0, "SystemOptions",
+              "keyframe_rotation_min_rate_deg", "must be >= 0");
   CheckOption(min_keyframe_usage >= 0.0 && min_keyframe_usage <= 1.0, "SystemOptions",
               "min_keyframe_usage", "must be in [0, 1]");
   CheckOption(min_update_baseline >= 0.0, "SystemOptions", "min_update_baseline", "must be >= 0");
@@ -97,7 +99,12 @@ bool SystemOptions::WantsKeyframe(int frames_in_keyframe, double relative_distan
       stats.usage < early_keyframe_usage && stats.good_ratio >= min_keyframe_good_ratio;
   return (frames_in_keyframe >= min_frames_per_keyframe || soon_out_of_view) &&
          (view_degrades || relative_distance > keyframe_distance ||
-          (keyframe_rotation_deg > 0.0 && rotation_deg > keyframe_rotation_deg));
+          TurnedPast(frames_in_keyframe, rotation_deg));
+}
+
+bool SystemOptions::TurnedPast(int frames_in_keyframe, double rotation_deg, double factor) const {
+  return keyframe_rotation_deg > 0.0 && rotation_deg > factor * keyframe_rotation_deg &&
+         rotation_deg >= keyframe_rotation_min_rate_deg * std::max(frames_in_keyframe, 1);
 }
 
 namespace {

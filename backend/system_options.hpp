@@ -119,6 +119,11 @@ struct SystemOptions {
   /// A rotation moves every point alike and is no distance for depth, but in a fast turn the
   /// view leaves the keyframe within a few frames (docs/math/keyframe_rule.md, "Turns").
   double keyframe_rotation_deg = 30.0;
+  /// The turn bound counts only for a turn faster than this, degrees per frame on average
+  /// over the keyframe's frames (0: any turn). A slow turn keeps the view for many frames and
+  /// the usage rule ends the keyframe when it leaves; a fast one (a U-turn) leaves it before
+  /// that rule can see it (docs/math/keyframe_rule.md, "Turns").
+  double keyframe_rotation_min_rate_deg = 4.0;
   double min_keyframe_usage = 0.6;
   /// ... or when the share of consistent points falls below this (the view has changed
   /// enough that the keyframe explains it worse; DSO uses a residual-growth rule alike).
@@ -211,6 +216,9 @@ struct SystemOptions {
   /// keyframe.
   bool WantsKeyframe(int frames_in_keyframe, double relative_distance, double rotation_deg,
                      const TrackingStats& stats) const;
+  /// The rule's turn bound alone, the bound multiplied by `factor` (the real-time mode's
+  /// overdue test): turned past it, faster than keyframe_rotation_min_rate_deg.
+  bool TurnedPast(int frames_in_keyframe, double rotation_deg, double factor = 1.0) const;
   /// The angle of `T_kf_frame`'s rotation, degrees (the rule's `rotation_deg`).
   static double RotationDeg(const SE3d& T_kf_frame);
 };

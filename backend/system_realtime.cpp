@@ -229,10 +229,9 @@ System::LiveStep System::TrackLive(const Frame& frame, const LiveSnapshot& snaps
                                                      relative_distance, rotation_deg, t.stats);
   step.keep = wants_keyframe && live_->keyframe_requested_in != snapshot.keyframe_id;
   const double f = options_.realtime.keyframe_wait_factor;
-  const double rotation_bound = options_.keyframe_rotation_deg;
   step.overdue = wants_keyframe && !step.keep &&
                  (relative_distance > f * options_.keyframe_distance ||
-                  (rotation_bound > 0.0 && rotation_deg > f * rotation_bound) ||
+                  options_.TurnedPast(live_->tracker.State().frames_in_keyframe, rotation_deg, f) ||
                   t.stats.usage * f < options_.min_keyframe_usage ||
                   t.stats.good_ratio * f < options_.min_keyframe_good_ratio);
   return step;

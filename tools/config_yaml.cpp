@@ -88,6 +88,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"keyframe_distance", Set(&o->keyframe_distance)},
         {"keyframe_distance_in_image", Set(&o->keyframe_distance_in_image)},
         {"keyframe_rotation_deg", Set(&o->keyframe_rotation_deg)},
+        {"keyframe_rotation_min_rate_deg", Set(&o->keyframe_rotation_min_rate_deg)},
         {"min_keyframe_usage", Set(&o->min_keyframe_usage)},
         {"min_keyframe_good_ratio", Set(&o->min_keyframe_good_ratio)},
         {"min_update_baseline", Set(&o->min_update_baseline)},

@@ -179,8 +179,8 @@ TEST(SystemOptions, AKeyframeComesEarlyOnlyWhenAConsistentViewLeavesIt) {
   EXPECT_THROW(options.Check(), std::invalid_argument);
 }
 
-// The turn criterion: a frame turned past it from its keyframe wants a new one (after
-// min_frames_per_keyframe), whatever its distance and view; 0 turns it off.
+// The turn criterion: a frame turned past it from its keyframe, fast enough, wants a new one
+// (after min_frames_per_keyframe), whatever its distance and view; 0 turns it off.
 TEST(SystemOptions, AFrameTurnedPastTheRotationBoundWantsAKeyframe) {
   SystemOptions options;
   TrackingStats steady;
@@ -188,6 +188,17 @@ TEST(SystemOptions, AFrameTurnedPastTheRotationBoundWantsAKeyframe) {
   steady.good_ratio = 0.95;
   const int enough = options.min_frames_per_keyframe;
   EXPECT_TRUE(options.WantsKeyframe(enough, 0.0, options.keyframe_rotation_deg + 1.0, steady));
+  // The same angle reached slowly (below keyframe_rotation_min_rate_deg a frame) is left to
+  // the usage rule; a rate of 0 counts every turn.
+  const double angle = options.keyframe_rotation_deg + 1.0;
+  const int slow = static_cast<int>(angle / options.keyframe_rotation_min_rate_deg) + 1;
+  EXPECT_FALSE(options.WantsKeyframe(slow, 0.0, angle, steady));
+  EXPECT_TRUE(options.WantsKeyframe(slow - 1, 0.0, angle, steady));
+  options.keyframe_rotation_min_rate_deg = 0.0;
+  EXPECT_TRUE(options.WantsKeyframe(slow, 0.0, angle, steady));
+  options.keyframe_rotation_min_rate_deg = -1.0;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+  options.keyframe_rotation_min_rate_deg = 0.0;
   options.keyframe_rotation_deg = 0.0;
   EXPECT_FALSE(options.WantsKeyframe(enough, 0.0, 90.0, steady));  // off: a turn is no distance
   options.keyframe_rotation_deg = 25.0;
