@@ -224,14 +224,15 @@ System::LiveStep System::TrackLive(const Frame& frame, const LiveSnapshot& snaps
   const double relative_distance =
       options_.KeyframeDistance(snapshot.parallax, t.T_kf_frame.Translation());
   const double rotation_deg = SystemOptions::RotationDeg(t.T_kf_frame);
+  const int frames_in_keyframe = live_->tracker.State().frames_in_keyframe;
   const bool wants_keyframe =
-      snapshot.initialised && options_.WantsKeyframe(live_->tracker.State().frames_in_keyframe,
-                                                     relative_distance, rotation_deg, t.stats);
+      snapshot.initialised &&
+      options_.WantsKeyframe(frames_in_keyframe, relative_distance, rotation_deg, t.stats);
   step.keep = wants_keyframe && live_->keyframe_requested_in != snapshot.keyframe_id;
   const double f = options_.realtime.keyframe_wait_factor;
   step.overdue = wants_keyframe && !step.keep &&
                  (relative_distance > f * options_.keyframe_distance ||
-                  options_.TurnedPast(live_->tracker.State().frames_in_keyframe, rotation_deg, f) ||
+                  options_.TurnedPast(frames_in_keyframe, rotation_deg, f) ||
                   t.stats.usage * f < options_.min_keyframe_usage ||
                   t.stats.good_ratio * f < options_.min_keyframe_good_ratio);
   return step;

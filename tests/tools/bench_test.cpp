@@ -57,18 +57,18 @@ TEST(BenchSuite, MinimalSuiteAndErrorsWithLines) {
   ASSERT_EQ(s.sequences.size(), 1u);
   EXPECT_EQ(s.sequences[0].path, std::filesystem::weakly_canonical(dir.File("data/seq")).string());
   EXPECT_EQ(s.configurations.size(), 1u);
-  const auto expect_line = [&](const std::string& text, int line, const std::string& fragment) {
-    ExpectSuiteErrorAt(dir, text, line, fragment);
-  };
-  expect_line("sequences:\n  - name: a\n    path: data/seq\n    colour: red\n", 4, "unknown key");
-  expect_line("sequences:\n  - name: a\n    path: nowhere\n", 3, "does not exist");
-  expect_line("sequences:\n  - {name: a, path: data/seq}\n  - {name: a, path: data/seq}\n", 3,
-              "duplicate");
-  expect_line("sequences:\n  - {name: a, synth: {scene: room, frames: 1}}\n", 2, "frames");
-  expect_line(
-      "sequences:\n  - {name: a, path: data/seq}\nconfigurations:\n"
-      "  - {name: live, realtime_rate: -1}\n",
-      4, "realtime_rate");
+  ExpectSuiteErrorAt(dir, "sequences:\n  - name: a\n    path: data/seq\n    colour: red\n", 4,
+                     "unknown key");
+  ExpectSuiteErrorAt(dir, "sequences:\n  - name: a\n    path: nowhere\n", 3, "does not exist");
+  ExpectSuiteErrorAt(dir,
+                     "sequences:\n  - {name: a, path: data/seq}\n  - {name: a, path: data/seq}\n",
+                     3, "duplicate");
+  ExpectSuiteErrorAt(dir, "sequences:\n  - {name: a, synth: {scene: room, frames: 1}}\n", 2,
+                     "frames");
+  ExpectSuiteErrorAt(dir,
+                     "sequences:\n  - {name: a, path: data/seq}\nconfigurations:\n"
+                     "  - {name: live, realtime_rate: -1}\n",
+                     4, "realtime_rate");
   const Suite modes = ReadSuite(dir.Write("modes.yaml",
                                           "sequences:\n  - {name: a, path: data/seq}\n"
                                           "configurations:\n  - {name: deterministic}\n"
@@ -176,25 +176,22 @@ TEST(BenchRunner, FirstFramesRunOneSequencePerStartJudgedFromItsStart) {
   with_peer.peer_programs.push_back({"dso", "/bin/true"});
   EXPECT_THROW(RunBench(suite, with_peer), std::invalid_argument);
   // Errors name the line: a start beyond the frames, a start with a peer's trajectory.
-  const auto expect_line = [&](const std::string& text, int line, const std::string& fragment) {
-    ExpectSuiteErrorAt(dir, text, line, fragment);
-  };
   dir.Write("data/seq/rgb.txt", "");
   dir.Write("data/peer.txt", "");
-  expect_line(
-      "sequences:\n  - name: a\n    path: data/seq\n    max_frames: 10\n"
-      "    first_frames: [2, 10]\n",
-      5, "below max_frames");
-  expect_line("sequences:\n  - name: a\n    path: data/seq\n    first_frames: [x]\n", 4,
-              "integers");
-  expect_line(
-      "sequences:\n  - name: a\n    path: data/seq\n    first_frames: [1]\n"
-      "    peers: {dso: data/peer.txt}\n",
-      4, "peers");
-  expect_line(
-      "sequences:\n  - {name: a@1, path: data/seq}\n"
-      "  - {name: a, path: data/seq, first_frames: [1]}\n",
-      3, "duplicate");
+  ExpectSuiteErrorAt(dir,
+                     "sequences:\n  - name: a\n    path: data/seq\n    max_frames: 10\n"
+                     "    first_frames: [2, 10]\n",
+                     5, "below max_frames");
+  ExpectSuiteErrorAt(dir, "sequences:\n  - name: a\n    path: data/seq\n    first_frames: [x]\n", 4,
+                     "integers");
+  ExpectSuiteErrorAt(dir,
+                     "sequences:\n  - name: a\n    path: data/seq\n    first_frames: [1]\n"
+                     "    peers: {dso: data/peer.txt}\n",
+                     4, "peers");
+  ExpectSuiteErrorAt(dir,
+                     "sequences:\n  - {name: a@1, path: data/seq}\n"
+                     "  - {name: a, path: data/seq, first_frames: [1]}\n",
+                     3, "duplicate");
 }
 
 TEST(BenchRunner, PeersAreEvaluatedLikeTheRun) {
