@@ -4,6 +4,7 @@
 
 #include <tbb/task_arena.h>
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -54,6 +55,8 @@ struct LiveTracker {
   std::int64_t queued_for_start = 0;  ///< answered at once, mapped later (the start)
   /// The newest start frame queued for mapping and not yet caught up with (-1: none).
   std::int64_t last_queued_start = -1;
+  /// Start frames the mapping thread tracked in the catch-up without refining depth.
+  std::atomic<std::int64_t> caught_up{0};
   /// The mapping thread's: the keyframe of its last snapshot, and the one before it.
   std::int64_t published_keyframe_id = -1;
   std::int64_t published_previous_id = -1;

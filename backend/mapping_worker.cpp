@@ -136,13 +136,17 @@ void MappingWorker::Loop() {
       if (stopping_) return;
       entry = std::move(queue_.front());
       queue_.pop_front();
+      entry.job.newer_waiting = !queue_.empty();
       busy_ = true;
     }
     idle_.notify_all();  // room in the queue: a caller waiting for room goes on now
     const bool waited = entry.done != nullptr;
+    // A keyframe request gets both cores too: the caller tracks against the old keyframe
+    // meanwhile and waits for the new one once it is overdue (docs/realtime.md).
+    const bool wide = waited || entry.job.caller_idle || entry.job.keep;
     std::exception_ptr error;
     std::optional<FrameResult> result;
-    (waited || entry.job.caller_idle ? waited_arena_ : arena_).execute([&] {
+    (wide ? waited_arena_ : arena_).execute([&] {
       try {
         result = process_(entry.job);
       } catch (...) {

@@ -52,6 +52,8 @@ struct MappingJob {
   /// Queued by Queue(): the caller's thread is idle meanwhile (the start answered at once),
   /// so the job gets the waited jobs' wider arena.
   bool caller_idle = false;
+  /// Set by the mapping thread when it takes the job: newer jobs were queued behind it.
+  bool newer_waiting = false;
   std::int64_t unbuilt_id = -1;
   double unbuilt_timestamp = 0.0;
 
@@ -64,7 +66,8 @@ class MappingWorker {
 
   /// `process` maps a job. `max_pending`: refinement jobs that may wait (>= 1); `threads`:
   /// the TBB concurrency of the thread's arena; `waited_threads`: that of the jobs the caller
-  /// waits for (Run), while the caller's thread is idle. The thread starts here.
+  /// waits for (Run) or is idle during (Queue), and of keyframe requests (`keep`), which the
+  /// caller soon waits for. The thread starts here.
   MappingWorker(Process process, std::size_t max_pending, int threads, int waited_threads);
   /// Stop().
   ~MappingWorker();

@@ -255,10 +255,10 @@ FrameResult System::ProcessFrame(const ImageU8& image, double timestamp) {
   return ProcessInOrder(frame, image);
 }
 
-FrameResult System::ProcessInOrder(const std::shared_ptr<const Frame>& frame,
-                                   const ImageU8& image) {
+FrameResult System::ProcessInOrder(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
+                                   DepthWork work) {
   result_frame_id_ = frame->Id();
-  FrameResult result = Process(frame, image);
+  FrameResult result = Process(frame, image, work);
   if (!result.T_w_c) result.events.push_back({SystemEvent::Kind::kLost, frame->Id(), -1});
   if (!result.revised.empty()) {
     result.events.push_back({SystemEvent::Kind::kPosesRevised, frame->Id(), -1});
@@ -270,7 +270,8 @@ FrameResult System::ProcessInOrder(const std::shared_ptr<const Frame>& frame,
   return result;
 }
 
-FrameResult System::Process(const std::shared_ptr<const Frame>& frame, const ImageU8& image) {
+FrameResult System::Process(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
+                            DepthWork work) {
   if (start_ == StartState::kNoKeyframe) return StartFirstKeyframe(frame, image);
   if (start_ == StartState::kRelocalising) return ProcessOnLoadedMap(frame, image);
   if (start_ == StartState::kTwoViewSearch) return ProcessTwoViewOnly(frame, image);
@@ -300,7 +301,7 @@ FrameResult System::Process(const std::shared_ptr<const Frame>& frame, const Ima
   if (start_ != StartState::kInitialised) {
     if (auto handled = ProcessWhileInitialising(frame, image, tracked)) return *handled;
   }
-  if (tracked.status != TrackingStatus::kLost) MapFrame(frame, image, tracked, &result);
+  if (tracked.status != TrackingStatus::kLost) MapFrame(frame, image, tracked, &result, work);
   return result;
 }
 
@@ -335,7 +336,7 @@ TrackingResult System::TrackFrame(const Frame& frame, FrameResult* result) {
 }
 
 void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
-                      const TrackingResult& tracked, FrameResult* result) {
+                      const TrackingResult& tracked, FrameResult* result, DepthWork work) {
   const auto start = Clock::now();
   // Distance relative to the mean depth (mean idepth is 1 after normalisation): the depth
   // updates' baseline, and the keyframe rule's distance (or, with keyframe_distance_in_image,
@@ -352,7 +353,12 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& 
       options_.WantsKeyframe(tracker_.State().frames_in_keyframe,
                              options_.KeyframeDistance(parallax, t_kf_frame),
                              SystemOptions::RotationDeg(tracked.T_kf_frame), tracked.stats);
-  if (tracked.status == TrackingStatus::kOk && relative_distance > options_.min_update_baseline) {
+  const bool refines =
+      work == DepthWork::kRefine ||
+      mapper_.Map().updates < static_cast<std::uint32_t>(options_.realtime.catch_up_refinements);
+  if (!refines && live_) ++live_->caught_up;
+  if (refines && tracked.status == TrackingStatus::kOk &&
+      relative_distance > options_.min_update_baseline) {
     // Only once initialised: the start's keyframe and its selection stay as they were.
     const bool initialised = start_ == StartState::kInitialised;
     const SE3d T_kf_update =

@@ -125,9 +125,15 @@ class System {
   int InitialisedAtFrame() const;
 
  private:
-  FrameResult Process(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
+  /// What mapping does with a tracked frame besides the keyframe rule: refine the keyframe's
+  /// depth with it, or only while the keyframe has had few updates (the real-time catch-up
+  /// after the start, docs/realtime.md).
+  enum class DepthWork { kRefine, kRefineYoungKeyframe };
+  FrameResult Process(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
+                      DepthWork work);
   /// The deterministic pipeline on one frame, with its events and record (engine lock held).
-  FrameResult ProcessInOrder(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
+  FrameResult ProcessInOrder(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
+                             DepthWork work = DepthWork::kRefine);
   // Real-time mode (system_realtime.cpp).
   /// Tracks on the caller's thread against the published keyframe; hands the frame on.
   FrameResult ProcessLive(std::int64_t id, double timestamp, const ImageU8& image);
@@ -222,7 +228,8 @@ class System {
   std::optional<TrackingResult> TrackRecentKeyframes(const Frame& frame, FrameResult* result);
   TrackingResult TrackFrame(const Frame& frame, FrameResult* result);
   void MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
-                const TrackingResult& tracked, FrameResult* result);
+                const TrackingResult& tracked, FrameResult* result,
+                DepthWork work = DepthWork::kRefine);
   /// Makes `frame` the new keyframe (depth propagated to it), or reports kDiverged and keeps
   /// the current one when the propagated map diverged.
   void SwitchKeyframe(const std::shared_ptr<const Frame>& frame, const ImageU8& image,

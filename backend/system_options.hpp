@@ -68,6 +68,11 @@ struct RealtimeOptions {
   /// complete the caller waits once until mapping has done the queued frames, then tracks
   /// live from mapping's newest state.
   int max_queued_start_frames = 30;
+  /// The catch-up after the start (docs/realtime.md): a queued frame with newer ones behind
+  /// it refines depth only while the current keyframe has had fewer than this many updates
+  /// (the start's keyframe has had initialization_updates; a keyframe made in the catch-up
+  /// gets this many before later frames only track).
+  int catch_up_refinements = 8;
 
   void Check() const;
 };

@@ -35,6 +35,7 @@ void RealtimeOptions::Check() const {
               "must be in [0, 19]");
   CheckOption(max_queued_start_frames >= 1, "RealtimeOptions", "max_queued_start_frames",
               "must be >= 1");
+  CheckOption(catch_up_refinements >= 0, "RealtimeOptions", "catch_up_refinements", "must be >= 0");
 }
 
 void System::StartRealtime() {
@@ -99,7 +100,7 @@ RealtimeStats System::Realtime() const {
   stats.frames_mapped_waiting = live_->mapped_waiting;
   stats.frames_queued_for_start = live_->queued_for_start;
   stats.frames_waiting_for_keyframe = live_->waited_for_keyframe;
-  stats.frames_skipped_by_mapping = worker_->Skipped();
+  stats.frames_skipped_by_mapping = worker_->Skipped() + live_->caught_up.load();
   return stats;
 }
 
@@ -297,7 +298,13 @@ FrameResult System::MapJob(const MappingJob& job) {
         job.frame ? job.frame
                   : std::make_shared<const Frame>(job.unbuilt_id, job.unbuilt_timestamp, camera_,
                                                   job.image, options_.pyramid);
-    result = ProcessInOrder(frame, job.image);
+    // A start frame with newer ones queued behind it, after the start completed (the
+    // catch-up): tracked, and a keyframe when the rule asks, but depth is refined only
+    // while the keyframe is young; the newest refines (docs/realtime.md, "The catch-up").
+    const bool catch_up =
+        job.caller_idle && job.newer_waiting && start_ == StartState::kInitialised;
+    result = ProcessInOrder(frame, job.image,
+                            catch_up ? DepthWork::kRefineYoungKeyframe : DepthWork::kRefine);
     // A frame the caller already has a pose for keeps it when tracking it again here failed.
     if (!result.T_w_c && job.live && !job.caller_waits) {
       FrameResult live;

@@ -70,7 +70,9 @@ struct RealtimeStats {
   std::int64_t frames_queued_for_start = 0;
   /// The caller waited for a keyframe it had asked for, then tracked the frame itself.
   std::int64_t frames_waiting_for_keyframe = 0;
-  std::int64_t frames_skipped_by_mapping = 0;  ///< tracked, never used to refine depth
+  /// Tracked, never used to refine depth: refinements mapping skipped when behind, and start
+  /// frames tracked in the catch-up after the start (docs/realtime.md).
+  std::int64_t frames_skipped_by_mapping = 0;
 };
 
 /// Keyframe-graph figures for stats.json.

@@ -146,9 +146,11 @@ TEST(MappingWorker, AKeyframeRequestGoesBeforeWaitingRefinementsAndCanBeWaitedFo
 TEST(MappingWorker, QueuedJobsAreNeverSkippedAndWaitOnlyWhenTheQueueIsFull) {
   GatedProcess process;
   std::vector<int> widths;
+  std::vector<bool> newer_waiting;
   MappingWorker worker(
       [&](const MappingJob& job) {
         widths.push_back(tbb::this_task_arena::max_concurrency());
+        newer_waiting.push_back(job.newer_waiting);
         return process.Function()(job);
       },
       1, 1, 2);
@@ -171,9 +173,17 @@ TEST(MappingWorker, QueuedJobsAreNeverSkippedAndWaitOnlyWhenTheQueueIsFull) {
   // 4 entered when mapping took 1, after the keyframe request.
   EXPECT_EQ(process.seen, (std::vector<std::int64_t>{0, 1, 2, 3, 6, 4}));
   EXPECT_EQ(worker.Skipped(), 1);
-  // Queued jobs have the wider arena (the caller's thread is idle), offered ones not.
+  // Queued jobs have the wider arena (the caller's thread is idle), and so has the keyframe
+  // request (the caller soon waits for it); a refinement has not (AWaitedJobHasTheWiderArena).
   const int wide = MappingWorker::ArenaWidth(2);
-  EXPECT_EQ(widths, (std::vector<int>{wide, wide, wide, wide, MappingWorker::ArenaWidth(1), wide}));
+  EXPECT_EQ(widths, (std::vector<int>{wide, wide, wide, wide, wide, wide}));
+  // Each job knows whether newer ones waited behind it when mapping took it: 1-3 had the
+  // keyframe request behind them, 4 was the last (0 may have been taken before the others
+  // were queued, and 6 before the caller's thread queued 4).
+  ASSERT_EQ(newer_waiting.size(), 6u);
+  EXPECT_EQ(std::vector<bool>(newer_waiting.begin() + 1, newer_waiting.begin() + 4),
+            (std::vector<bool>{true, true, true}));
+  EXPECT_FALSE(newer_waiting.back());
 }
 
 TEST(MappingWorker, AWaitForEndsWhenTheWorkerStops) {
@@ -365,6 +375,45 @@ TEST(Realtime, TheStartIsAnsweredAtOnceAndItsFramesArePosedWithTheMap) {
     // Every start frame was mapped in order (none skipped): the start's frames have their
     // poses in the final trajectory, as in the deterministic mode.
     EXPECT_GE(start_posed, first_live - 1) << "at_once " << at_once;
+  }
+}
+
+TEST(Realtime, StartFramesQueuedBehindTheStartAreCaughtUpWithoutRefiningEach) {
+  // Rendered first, then fed at once: the start (about 20 frames, each mapped with a depth
+  // update) completes long after the last frame was queued, so frames wait behind the one
+  // that completed it. They are tracked in order and posed; depth is refined by the newest
+  // and by the first catch_up_refinements of a keyframe made meanwhile, by no other
+  // (docs/realtime.md, "The catch-up"). With a bound no keyframe reaches, every one refines.
+  const int frames = 40;
+  std::vector<ImageU8> images;
+  images.reserve(frames);
+  for (int k = 0; k < frames; ++k) images.push_back(test::RenderTestImage(Room(), OrbitPose(k)));
+  for (const int refinements : {2, 1000}) {
+    SystemOptions options = Realtime();
+    options.realtime.max_queued_start_frames = frames;
+    options.realtime.catch_up_refinements = refinements;
+    System system(test::TestCamera(), options);
+    for (int k = 0; k < frames; ++k) {
+      system.ProcessFrame(images[static_cast<std::size_t>(k)], k / 30.0);
+    }
+    system.FinishMapping();
+    const RealtimeStats stats = system.Realtime();
+    const int start = system.InitialisedAtFrame();
+    ASSERT_GT(start, 0);
+    ASSERT_LT(start, frames - 2);
+    EXPECT_EQ(stats.frames_queued_for_start, frames);
+    EXPECT_EQ(stats.frames_tracked_live, 0);
+    // Frames start + 1 .. frames - 2 had newer ones behind them.
+    const int behind = frames - 2 - start;
+    if (refinements == 2) {
+      EXPECT_GT(stats.frames_skipped_by_mapping, behind / 2) << "start " << start;
+      EXPECT_LE(stats.frames_skipped_by_mapping, behind);
+    } else {
+      EXPECT_EQ(stats.frames_skipped_by_mapping, 0);
+    }
+    std::set<std::int64_t> posed;
+    for (const FramePose& p : system.Trajectory()) posed.insert(p.frame_id);
+    for (int k = start + 1; k < frames; ++k) EXPECT_EQ(posed.count(k), 1u) << "frame " << k;
   }
 }
 
