@@ -141,9 +141,10 @@ void MappingWorker::Loop() {
     }
     idle_.notify_all();  // room in the queue: a caller waiting for room goes on now
     const bool waited = entry.done != nullptr;
-    // A keyframe request gets both cores too: the caller tracks against the old keyframe
-    // meanwhile and waits for the new one once it is overdue (docs/realtime.md).
-    const bool wide = waited || entry.job.caller_idle || entry.job.keep;
+    // Jobs never skipped get both cores: queued start frames (the caller is idle) and
+    // keyframe requests (the caller tracks against the old keyframe meanwhile and waits for
+    // the new one once it is overdue; docs/realtime.md).
+    const bool wide = waited || entry.job.keep;
     std::exception_ptr error;
     std::optional<FrameResult> result;
     (wide ? waited_arena_ : arena_).execute([&] {
