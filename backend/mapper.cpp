@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "depth/depth_map.hpp"
 
@@ -50,7 +51,8 @@ std::pair<InverseDepthMap, float> Mapper::Propagate(const std::shared_ptr<const 
                                                     const TrackingResult& tracked,
                                                     PropagationStats* stats) {
   // The current map is finished next (or, if this throws, updated again with new memory):
-  // its working memory moves on to the new map.
+  // its working memory moves on to the new map, with the arrays of the last map dropped.
+  map_->scratch.recycled = std::exchange(spare_arrays_, {});
   InverseDepthMap next =
       depth_filter_.Propagate(*map_, frame, tracked.T_kf_frame.Inverse(), tracked.affine.Gain(),
                               tracked.affine.b, stats, std::move(map_->scratch));
@@ -79,7 +81,12 @@ void Mapper::Retire() {
   if (map_) map_->scratch.Release();  // no longer updated (a return to it allocates again)
   if (recent_keyframes_ > 0) {
     recent_.push_front({std::move(map_), std::move(reference_)});
-    if (static_cast<int>(recent_.size()) > recent_keyframes_) recent_.pop_back();
+    if (static_cast<int>(recent_.size()) > recent_keyframes_) {
+      spare_arrays_ = recent_.back().map->TakeArrays();  // the next new map's memory
+      recent_.pop_back();
+    }
+  } else if (map_) {
+    spare_arrays_ = map_->TakeArrays();
   }
   map_.reset();
   reference_.reset();
@@ -102,6 +109,7 @@ std::vector<std::int64_t> Mapper::LiveKeyframeIds() const {
 
 void Mapper::Clear() {
   recent_.clear();
+  spare_arrays_ = {};
   map_.reset();
   reference_.reset();
 }

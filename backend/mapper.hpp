@@ -81,6 +81,8 @@ class Mapper {
   std::unique_ptr<InverseDepthMap> map_;
   std::shared_ptr<const TrackingReference> reference_;
   std::deque<Recent> recent_;  ///< newest first
+  /// The arrays of the last map dropped, which the next propagated map reuses.
+  RecycledArrays spare_arrays_;
 };
 
 }  // namespace parallax

@@ -134,26 +134,22 @@ ImagePyramid::ImagePyramid(const ImageView<std::uint8_t>& image, const PyramidOp
 ImageF MaxGradient3x3(const PyramidLevel& level) {
   const int w = level.Width();
   const int h = level.Height();
-  ImageF magnitude(w, h);
-  for (std::size_t i = 0; i < magnitude.NumPixels(); ++i) {
-    magnitude.Data()[i] = std::sqrt(level.grad_sq.Data()[i]);
-  }
-  // Separable max filter: horizontal then vertical, clamped at the border.
-  ImageF horizontal(w, h);
-  for (int y = 0; y < h; ++y) {
-    const float* src = magnitude.Row(y);
-    float* dst = horizontal.Row(y);
-    for (int x = 0; x < w; ++x) {
-      dst[x] = std::max({src[std::max(x - 1, 0)], src[x], src[std::min(x + 1, w - 1)]});
-    }
-  }
+  // One pass over the squared gradients, clamped at the border, without full-size
+  // temporaries (a new map's first touch of fresh memory is what this cost, docs/benchmarks.md
+  // "Keyframe creation: a new map's memory"). sqrt is monotonic and correctly rounded, so the
+  // square root of the largest square is exactly the largest magnitude.
   ImageF out(w, h);
   for (int y = 0; y < h; ++y) {
-    const float* up = horizontal.Row(std::max(y - 1, 0));
-    const float* mid = horizontal.Row(y);
-    const float* down = horizontal.Row(std::min(y + 1, h - 1));
+    const std::array<const float*, 3> rows = {level.grad_sq.Row(std::max(y - 1, 0)),
+                                              level.grad_sq.Row(y),
+                                              level.grad_sq.Row(std::min(y + 1, h - 1))};
     float* dst = out.Row(y);
-    for (int x = 0; x < w; ++x) dst[x] = std::max({up[x], mid[x], down[x]});
+    for (int x = 0; x < w; ++x) {
+      const int left = std::max(x - 1, 0), right = std::min(x + 1, w - 1);
+      float largest = 0.0f;
+      for (const float* row : rows) largest = std::max({largest, row[left], row[x], row[right]});
+      dst[x] = std::sqrt(largest);
+    }
   }
   if (level.valid != nullptr) {  // the maximum must not spread back into the border
     for (std::size_t i = 0; i < out.NumPixels(); ++i) {

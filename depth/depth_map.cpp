@@ -38,9 +38,25 @@ void DepthFilterOptions::Check() const {
 }
 
 InverseDepthMap::InverseDepthMap(std::shared_ptr<const Frame> keyframe,
-                                 const DepthFilterOptions& options)
-    : keyframe_(std::move(keyframe)), width_(0), height_(0), options_(options) {
+                                 const DepthFilterOptions& options, MapScratch scratch_memory)
+    : scratch(std::move(scratch_memory)),
+      keyframe_(std::move(keyframe)),
+      width_(0),
+      height_(0),
+      options_(options) {
   options_.Check();
+  // The assignments below keep a recycled array's memory (same size, same capacity).
+  RecycledArrays& r = scratch.recycled;
+  idepth.swap(r.floats[0]);
+  variance.swap(r.floats[1]);
+  idepth_smoothed.swap(r.floats[2]);
+  variance_smoothed.swap(r.floats[3]);
+  validity.swap(r.floats[4]);
+  blacklist.swap(r.blacklist);
+  valid.swap(r.bytes[0]);
+  eligible.swap(r.bytes[1]);
+  observations.swap(r.observations);
+  r = RecycledArrays{};
   CheckArgument(keyframe_ != nullptr, "InverseDepthMap: keyframe is null");
   width_ = keyframe_->Level(0).Width();
   height_ = keyframe_->Level(0).Height();
@@ -61,6 +77,16 @@ InverseDepthMap::InverseDepthMap(std::shared_ptr<const Frame> keyframe,
       eligible[Index(x, y)] = max_gradient(x, y) >= options_.min_gradient;
     }
   }
+}
+
+RecycledArrays InverseDepthMap::TakeArrays() {
+  RecycledArrays r;
+  r.floats = {std::move(idepth), std::move(variance), std::move(idepth_smoothed),
+              std::move(variance_smoothed), std::move(validity)};
+  r.blacklist = std::move(blacklist);
+  r.bytes = {std::move(valid), std::move(eligible)};
+  r.observations = std::move(observations);
+  return r;
 }
 
 void InverseDepthMap::InitializeRandom(float mean_idepth) {

@@ -13,6 +13,16 @@
 
 namespace parallax {
 
+/// The per-pixel arrays of a map that is no longer kept, for the next map to reuse: their
+/// memory is already resident, where fresh memory is first touched page by page
+/// (docs/benchmarks.md, "Keyframe creation: a new map's memory").
+struct RecycledArrays {
+  std::array<std::vector<float>, 5> floats;
+  std::vector<std::int16_t> blacklist;
+  std::array<std::vector<std::uint8_t>, 2> bytes;
+  std::vector<std::uint16_t> observations;
+};
+
 /// Working memory of the filter's passes over a map (DepthFilter::Regularize and FillHoles),
 /// kept with the map so that a stereo update allocates nothing, and handed on to the map
 /// propagated from it (DepthFilter::Propagate). Not map state: a copy starts empty, and
@@ -33,6 +43,8 @@ class MapScratch {
   /// Hole filling's window sums (support, inverse variance, inverse depth / variance) and
   /// its box filter's row sums.
   std::array<std::vector<float>, 4> fill;
+  /// Arrays a new map built with this scratch takes instead of allocating its own.
+  RecycledArrays recycled;
 };
 
 /// Per-pixel state of the inverse-depth filter (index = y * width + x). A pixel has an
@@ -42,8 +54,10 @@ class MapScratch {
 class InverseDepthMap {
  public:
   /// An empty map for `keyframe`: no estimates; pixels eligible where the 3x3 max gradient is
-  /// >= options.min_gradient.
-  InverseDepthMap(std::shared_ptr<const Frame> keyframe, const DepthFilterOptions& options);
+  /// >= options.min_gradient. The map keeps `scratch` as its working memory and takes the
+  /// arrays recycled in it (if any) for its own.
+  InverseDepthMap(std::shared_ptr<const Frame> keyframe, const DepthFilterOptions& options,
+                  MapScratch scratch = {});
 
   const Frame& Keyframe() const { return *keyframe_; }
   const std::shared_ptr<const Frame>& KeyframePtr() const { return keyframe_; }
@@ -87,6 +101,9 @@ class InverseDepthMap {
   std::uint32_t updates = 0;
   /// The filter's working memory (see MapScratch); empty in a copy.
   MapScratch scratch;
+
+  /// Moves the per-pixel arrays out for a later map (RecycledArrays); the map is empty after.
+  RecycledArrays TakeArrays();
 
   /// Valid with at least one stereo observation (or from a prior).
   bool IsConfirmed(std::size_t i) const { return valid[i] && observations[i] > 0; }

@@ -107,8 +107,7 @@ InverseDepthMap DepthFilter::Propagate(const InverseDepthMap& old_map,
                                        const SE3d& T_new_old, float gain, float offset,
                                        PropagationStats* stats, MapScratch scratch) const {
   CheckArgument(new_keyframe != nullptr, "DepthFilter::Propagate: no keyframe");
-  InverseDepthMap map(new_keyframe, options_);
-  map.scratch = std::move(scratch);
+  InverseDepthMap map(new_keyframe, options_, std::move(scratch));
   CheckArgument(map.Width() == old_map.Width() && map.Height() == old_map.Height(),
                 "DepthFilter::Propagate: keyframe sizes differ");
   PropagationStats local;

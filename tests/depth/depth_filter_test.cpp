@@ -7,6 +7,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 
 #include "tests/tracking/render_fixture.hpp"
@@ -301,6 +302,37 @@ TEST_F(DepthFilterTest, UpdatesAndPropagationAreTheSameForAnyThreadCount) {
   const auto one = run(1), two = run(2);
   EXPECT_GT(one->NumValid(), 10000u);
   EXPECT_TRUE(SameMap(*one, *two));
+}
+
+TEST_F(DepthFilterTest, APropagatedMapOnRecycledArraysIsTheSameAndReusesTheirMemory) {
+  // The mapper hands the arrays of the map it last dropped to the next propagated one. They
+  // hold that map's values, made odd here everywhere: each must be overwritten.
+  const DepthFilter filter;
+  InverseDepthMap map(keyframe_->frame, filter.Options());
+  map.InitializeRandom(1.0f);
+  for (int i = 1; i <= 5; ++i) filter.Update(&map, Stereo(i));
+  InverseDepthMap dropped = map;
+  for (std::vector<float>* v : {&dropped.idepth, &dropped.variance, &dropped.idepth_smoothed,
+                                &dropped.variance_smoothed, &dropped.validity}) {
+    std::fill(v->begin(), v->end(), 3.5f);
+  }
+  std::fill(dropped.blacklist.begin(), dropped.blacklist.end(), std::int16_t{-7});
+  std::fill(dropped.valid.begin(), dropped.valid.end(), std::uint8_t{1});
+  std::fill(dropped.eligible.begin(), dropped.eligible.end(), std::uint8_t{1});
+  std::fill(dropped.observations.begin(), dropped.observations.end(), std::uint16_t{99});
+  const float* memory = dropped.variance_smoothed.data();
+  MapScratch scratch;
+  scratch.recycled = dropped.TakeArrays();
+  EXPECT_TRUE(dropped.idepth.empty());
+
+  const SE3d T_new_old = Pose(10).Inverse() * T_w_kf_;
+  const InverseDepthMap fresh = filter.Propagate(map, frames_[9], T_new_old);
+  const InverseDepthMap recycled =
+      filter.Propagate(map, frames_[9], T_new_old, 1.0f, 0.0f, nullptr, std::move(scratch));
+  EXPECT_GT(fresh.NumValid(), 10000u);
+  EXPECT_TRUE(SameMap(fresh, recycled));
+  EXPECT_EQ(fresh.eligible, recycled.eligible);
+  EXPECT_EQ(recycled.variance_smoothed.data(), memory);
 }
 
 TEST_F(DepthFilterTest, PropagationTransportsVarianceWithDepthChange) {
