@@ -135,9 +135,9 @@ ImageF MaxGradient3x3(const PyramidLevel& level) {
   const int w = level.Width();
   const int h = level.Height();
   // One pass over the squared gradients, clamped at the border, without full-size
-  // temporaries (a new map's first touch of fresh memory is what this cost, docs/benchmarks.md
-  // "Keyframe creation: a new map's memory"). sqrt is monotonic and correctly rounded, so the
-  // square root of the largest square is exactly the largest magnitude.
+  // temporaries: their first touch of fresh memory was most of this function's cost
+  // (docs/benchmarks.md, "Where a depth update and a keyframe spend their time"). sqrt is
+  // monotonic and correctly rounded: the root of the largest square is the largest magnitude.
   ImageF out(w, h);
   for (int y = 0; y < h; ++y) {
     const std::array<const float*, 3> rows = {level.grad_sq.Row(std::max(y - 1, 0)),

@@ -15,7 +15,7 @@ namespace parallax {
 
 /// The per-pixel arrays of a map that is no longer kept, for the next map to reuse: their
 /// memory is already resident, where fresh memory is first touched page by page
-/// (docs/benchmarks.md, "Keyframe creation: a new map's memory").
+/// (docs/benchmarks.md, "Where a depth update and a keyframe spend their time").
 struct RecycledArrays {
   std::array<std::vector<float>, 5> floats;
   std::vector<std::int16_t> blacklist;
