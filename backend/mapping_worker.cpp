@@ -22,11 +22,12 @@ constexpr bool kThreadSanitizer = false;
 int MappingWorker::ArenaWidth(int threads) { return kThreadSanitizer ? 1 : threads; }
 
 MappingWorker::MappingWorker(Process process, std::size_t max_pending, int threads,
-                             int waited_threads)
+                             int waited_threads, int keyframe_threads)
     : process_(std::move(process)),
       max_pending_(max_pending),
       arena_(ArenaWidth(threads)),
-      waited_arena_(ArenaWidth(waited_threads)) {
+      waited_arena_(ArenaWidth(waited_threads)),
+      keyframe_arena_(ArenaWidth(keyframe_threads)) {
   CheckArgument(max_pending_ >= 1, "MappingWorker: max_pending must be >= 1");
   thread_ = std::thread([this] { Loop(); });
 }
@@ -141,13 +142,14 @@ void MappingWorker::Loop() {
     }
     idle_.notify_all();  // room in the queue: a caller waiting for room goes on now
     const bool waited = entry.done != nullptr;
-    // Jobs never skipped get both cores: queued start frames (the caller is idle) and
-    // keyframe requests (the caller tracks against the old keyframe meanwhile and waits for
-    // the new one once it is overdue; docs/realtime.md).
-    const bool wide = waited || entry.job.keep;
+    // Jobs the caller waits for or is idle during may have both cores; a keyframe request
+    // shares them with live tracking (docs/realtime.md, "Thread budget").
+    tbb::task_arena& arena = waited || entry.job.caller_idle ? waited_arena_
+                             : entry.job.keep                ? keyframe_arena_
+                                                             : arena_;
     std::exception_ptr error;
     std::optional<FrameResult> result;
-    (wide ? waited_arena_ : arena_).execute([&] {
+    arena.execute([&] {
       try {
         result = process_(entry.job);
       } catch (...) {

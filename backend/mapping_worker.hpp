@@ -66,9 +66,11 @@ class MappingWorker {
 
   /// `process` maps a job. `max_pending`: refinement jobs that may wait (>= 1); `threads`:
   /// the TBB concurrency of the thread's arena; `waited_threads`: that of the jobs the caller
-  /// waits for (Run) or is idle during (Queue), and of keyframe requests (`keep`), which the
-  /// caller soon waits for. The thread starts here.
-  MappingWorker(Process process, std::size_t max_pending, int threads, int waited_threads);
+  /// waits for (Run) or is idle during (Queue); `keyframe_threads`: that of keyframe
+  /// requests offered while the caller tracks (`keep`), which it may soon wait for. The
+  /// thread starts here.
+  MappingWorker(Process process, std::size_t max_pending, int threads, int waited_threads,
+                int keyframe_threads);
   /// Stop().
   ~MappingWorker();
   MappingWorker(const MappingWorker&) = delete;
@@ -114,6 +116,7 @@ class MappingWorker {
   std::size_t max_pending_;
   tbb::task_arena arena_;
   tbb::task_arena waited_arena_;
+  tbb::task_arena keyframe_arena_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;  ///< a job was queued, or stop
   std::condition_variable idle_;  ///< a job finished

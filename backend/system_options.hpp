@@ -41,6 +41,9 @@ struct RealtimeOptions {
   /// live): tracking is idle meanwhile, so they may have both cores. (Under ThreadSanitizer
   /// every real-time arena is one thread wide: libtbb is not instrumented.)
   int waited_mapping_threads = 2;
+  /// TBB concurrency of a requested keyframe's job: it runs while the caller tracks the next
+  /// frames, and a second thread there takes time from live tracking on two cores.
+  int keyframe_mapping_threads = 2;
   /// OpenCV's thread pool (ORB extraction on the mapping thread) is process-wide: a
   /// real-time System sets it to this when it starts.
   int opencv_threads = 1;

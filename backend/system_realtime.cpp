@@ -25,6 +25,8 @@ void RealtimeOptions::Check() const {
   CheckOption(mapping_threads >= 1, "RealtimeOptions", "mapping_threads", "must be >= 1");
   CheckOption(waited_mapping_threads >= 1, "RealtimeOptions", "waited_mapping_threads",
               "must be >= 1");
+  CheckOption(keyframe_mapping_threads >= 1, "RealtimeOptions", "keyframe_mapping_threads",
+              "must be >= 1");
   CheckOption(opencv_threads >= 1, "RealtimeOptions", "opencv_threads", "must be >= 1");
   CheckOption(keyframe_wait_factor >= 1.0, "RealtimeOptions", "keyframe_wait_factor",
               "must be >= 1");
@@ -47,7 +49,8 @@ void System::StartRealtime() {
   worker_ = std::make_unique<MappingWorker>(
       [this](const MappingJob& job) { return MapJob(job); },
       static_cast<std::size_t>(options_.realtime.max_pending_frames),
-      options_.realtime.mapping_threads, options_.realtime.waited_mapping_threads);
+      options_.realtime.mapping_threads, options_.realtime.waited_mapping_threads,
+      options_.realtime.keyframe_mapping_threads);
 }
 
 System::~System() { StopMapping(); }

@@ -167,6 +167,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"tracking_threads", Set(&o->realtime.tracking_threads)},
         {"mapping_threads", Set(&o->realtime.mapping_threads)},
         {"waited_mapping_threads", Set(&o->realtime.waited_mapping_threads)},
+        {"keyframe_mapping_threads", Set(&o->realtime.keyframe_mapping_threads)},
         {"opencv_threads", Set(&o->realtime.opencv_threads)},
         {"keyframe_wait_factor", Set(&o->realtime.keyframe_wait_factor)},
         {"snapshot_keyframe_poses", Set(&o->realtime.snapshot_keyframe_poses)},

@@ -55,7 +55,7 @@ struct GatedProcess {
 
 TEST(MappingWorker, WhenBehindTheOldestWaitingRefinementIsSkipped) {
   GatedProcess process;
-  MappingWorker worker(process.Function(), 1, 1, 1);
+  MappingWorker worker(process.Function(), 1, 1, 1, 1);
   worker.Offer(Job(0));  // taken by the thread, blocked at the gate (or still queued)
   for (int id = 1; id <= 5; ++id) worker.Offer(Job(id));
   MappingJob kept = Job(6);
@@ -74,7 +74,7 @@ TEST(MappingWorker, WhenBehindTheOldestWaitingRefinementIsSkipped) {
 TEST(MappingWorker, AWaitedJobRunsAfterTheQueuedOnesAndExceptionsReachTheCaller) {
   GatedProcess process;
   process.open.set_value();
-  MappingWorker worker(process.Function(), 4, 1, 1);
+  MappingWorker worker(process.Function(), 4, 1, 1, 1);
   worker.Offer(Job(1));
   worker.Run(Job(2));
   EXPECT_EQ(process.seen, (std::vector<std::int64_t>{1, 2}));
@@ -93,7 +93,7 @@ TEST(MappingWorker, AWaitedJobHasTheWiderArena) {
         widths.push_back(tbb::this_task_arena::max_concurrency());  // one job at a time
         return FrameResult{};
       },
-      4, 1, 2);
+      4, 1, 2, 2);
   worker.Offer(Job(1));
   worker.Run(Job(2));
   EXPECT_EQ(widths, (std::vector<int>{1, MappingWorker::ArenaWidth(2)}));
@@ -102,7 +102,7 @@ TEST(MappingWorker, AWaitedJobHasTheWiderArena) {
 
 TEST(MappingWorker, StopDropsWaitingJobsAndRefusesNewOnes) {
   GatedProcess process;
-  MappingWorker worker(process.Function(), 8, 1, 1);
+  MappingWorker worker(process.Function(), 8, 1, 1, 1);
   for (int id = 0; id < 5; ++id) worker.Offer(Job(id));
   // The gate opens only once Stop has dropped the waiting jobs: WaitFor on a frame that is
   // never mapped returns when the worker stops. (Opening it at once let the thread map a
@@ -120,7 +120,7 @@ TEST(MappingWorker, StopDropsWaitingJobsAndRefusesNewOnes) {
 
 TEST(MappingWorker, AKeyframeRequestGoesBeforeWaitingRefinementsAndCanBeWaitedFor) {
   GatedProcess process;
-  MappingWorker worker(process.Function(), 4, 1, 1);
+  MappingWorker worker(process.Function(), 4, 1, 1, 1);
   worker.Offer(Job(0));
   worker.Offer(Job(1));
   worker.Offer(Job(2));
@@ -153,7 +153,7 @@ TEST(MappingWorker, QueuedJobsAreNeverSkippedAndWaitOnlyWhenTheQueueIsFull) {
         newer_waiting.push_back(job.newer_waiting);
         return process.Function()(job);
       },
-      1, 1, 2);
+      1, 1, 2, 1);
   // Job 0 is taken by the thread (or still waits); with at most 3 waiting, 1-3 are queued
   // without the caller waiting, although mapping is blocked at the gate.
   for (int id = 0; id < 4; ++id) worker.Queue(Job(id), 3);
@@ -173,10 +173,11 @@ TEST(MappingWorker, QueuedJobsAreNeverSkippedAndWaitOnlyWhenTheQueueIsFull) {
   // 4 entered when mapping took 1, after the keyframe request.
   EXPECT_EQ(process.seen, (std::vector<std::int64_t>{0, 1, 2, 3, 6, 4}));
   EXPECT_EQ(worker.Skipped(), 1);
-  // Queued jobs have the wider arena (the caller's thread is idle), and so has the keyframe
-  // request (the caller soon waits for it); a refinement has not (AWaitedJobHasTheWiderArena).
+  // Queued jobs have the wider arena (the caller's thread is idle); the keyframe request
+  // has the keyframe arena (one thread here); a refinement has the narrow one
+  // (AWaitedJobHasTheWiderArena).
   const int wide = MappingWorker::ArenaWidth(2);
-  EXPECT_EQ(widths, (std::vector<int>{wide, wide, wide, wide, wide, wide}));
+  EXPECT_EQ(widths, (std::vector<int>{wide, wide, wide, wide, 1, wide}));
   // Each job knows whether newer ones waited behind it when mapping took it: 1-3 had the
   // keyframe request behind them, 4 was the last (0 may have been taken before the others
   // were queued, and 6 before the caller's thread queued 4).
@@ -188,7 +189,7 @@ TEST(MappingWorker, QueuedJobsAreNeverSkippedAndWaitOnlyWhenTheQueueIsFull) {
 
 TEST(MappingWorker, AWaitForEndsWhenTheWorkerStops) {
   GatedProcess process;
-  MappingWorker worker(process.Function(), 4, 1, 1);
+  MappingWorker worker(process.Function(), 4, 1, 1, 1);
   MappingJob kept = Job(5);
   kept.keep = true;
   worker.Offer(std::move(kept));
@@ -260,7 +261,7 @@ std::multiset<std::string> ThreadNames() {
 TEST(Workers, TheirThreadsAreNamedForProfilersAndDebuggers) {
   const std::size_t mapping_before = ThreadNames().count("px-mapping");
   const std::size_t backend_before = ThreadNames().count("px-backend");
-  MappingWorker mapping([](const MappingJob&) { return FrameResult{}; }, 2, 1, 1);
+  MappingWorker mapping([](const MappingJob&) { return FrameResult{}; }, 2, 1, 1, 1);
   BackendWorker backend([] {}, 1, 0);
   mapping.Run(Job(1));  // the thread has started (and named itself) once a job has run
   backend.Notify();
