@@ -62,7 +62,10 @@ double System::BufferedResidual(BufferedPoses* poses) {
 
 void System::RefineWithBufferedFrames() {
   AffineBrightness affine;
-  for (auto& [frame, T_kf_frame] : initial_frames_) {
+  const std::size_t n = initial_frames_.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!options_.PairRefinesWith(i, n)) continue;
+    auto& [frame, T_kf_frame] = initial_frames_[i];
     const TrackingResult r = tracker_.TrackFrom(*mapper_.Reference(), *frame, T_kf_frame, affine);
     if (r.status != TrackingStatus::kOk) continue;
     affine = r.affine;

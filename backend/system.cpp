@@ -48,6 +48,7 @@ void SystemOptions::Check() const {
               "must be > 0");
   CheckOption(auto_pair_residual_ratio >= 0.0, "SystemOptions", "auto_pair_residual_ratio",
               "must be >= 0 (0: no comparison)");
+  CheckOption(pair_refine_stride >= 1, "SystemOptions", "pair_refine_stride", "must be >= 1");
   CheckOption(restart_after_lost >= 1, "SystemOptions", "restart_after_lost", "must be >= 1");
   CheckOption(max_start_exposure_change > 1.0 && std::isfinite(max_start_exposure_change),
               "SystemOptions", "max_start_exposure_change", "must be > 1 and finite");
@@ -88,6 +89,12 @@ double SystemOptions::KeyframeDistance(const ParallaxMoments& parallax,
 
 double SystemOptions::RotationDeg(const SE3d& T_kf_frame) {
   return T_kf_frame.Rotation().Log().norm() * kRadToDeg;
+}
+
+bool SystemOptions::PairRefinesWith(std::size_t index, std::size_t buffered) const {
+  // Counted from the newest: it refines last and is the frame tracking goes on from.
+  return index < buffered &&
+         (buffered - 1 - index) % static_cast<std::size_t>(pair_refine_stride) == 0;
 }
 
 bool SystemOptions::WantsKeyframe(int frames_in_keyframe, double relative_distance,

@@ -2,6 +2,8 @@
 // Options of the System (backend/system.hpp): the start, the keyframe rule, each stage's
 // options and the real-time mode (docs/configuration.md).
 
+#include <cstddef>
+
 #include "backend/graph_backend.hpp"
 #include "backend/keyframe_refinement.hpp"
 #include "backend/loop_closer.hpp"
@@ -96,6 +98,12 @@ struct SystemOptions {
   /// initialisation": since the sub-pixel pair, 0.9 kept the worse start on most sequences
   /// where the two differ).
   double auto_pair_residual_ratio = 0.0;
+  /// Auto, refining the pair's start with the buffered frames: every this-many-th frame,
+  /// counted back from the newest (which always refines), is tracked and updates depth; the
+  /// others keep the pose the pair's first tracking gave them until the start tracks them
+  /// all again. 1: every frame (the default until 2026-12-06; docs/configuration.md,
+  /// "Choosing the initialisation", has why 2 and on which sets it was chosen and judged).
+  int pair_refine_stride = 2;
   /// The first keyframe needs at least this share of its pixels with enough gradient for
   /// depth (a dark or blank first frame is skipped and reported lost).
   double min_start_texture = 0.01;
@@ -229,6 +237,9 @@ struct SystemOptions {
   bool TurnedPast(int frames_in_keyframe, double rotation_deg, double factor = 1.0) const;
   /// The angle of `T_kf_frame`'s rotation, degrees (the rule's `rotation_deg`).
   static double RotationDeg(const SE3d& T_kf_frame);
+  /// Whether the pair's start is refined with buffered frame `index` of `buffered` (oldest
+  /// first): every pair_refine_stride-th, counted back from the newest, which always is.
+  bool PairRefinesWith(std::size_t index, std::size_t buffered) const;
 };
 
 }  // namespace parallax

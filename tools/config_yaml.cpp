@@ -75,6 +75,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"auto_max_rotation_deg", Set(&o->auto_max_rotation_deg)},
         {"auto_max_direction_deg", Set(&o->auto_max_direction_deg)},
         {"auto_pair_residual_ratio", Set(&o->auto_pair_residual_ratio)},
+        {"pair_refine_stride", Set(&o->pair_refine_stride)},
         {"restart_after_lost", Set(&o->restart_after_lost)},
         {"max_start_exposure_change", Set(&o->max_start_exposure_change)},
         {"min_start_texture", Set(&o->min_start_texture)},
