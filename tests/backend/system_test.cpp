@@ -256,9 +256,8 @@ TEST(Pipeline, AutoStartKeepsThePairWhenTheGeometryAgrees) {
 }
 
 TEST(Pipeline, ThePairRefinedByEveryOtherBufferedFrameIsMoreAccurate) {
-  // Desk shake, seed 4 (a judging sequence of pair_refine_stride, docs/configuration.md):
-  // neighbouring frames' errors are correlated, and fusing each as independent made the
-  // start's depth overconfident. Measured 2026-12-06: 0.057% of path with every frame,
+  // Desk shake, seed 4, a judging sequence of pair_refine_stride (docs/configuration.md,
+  // "Choosing the initialisation"). Measured 2026-12-06: 0.057% of path with every frame,
   // 0.022% with every second.
   RunSummary every, every_other;
   const double every_percent =
