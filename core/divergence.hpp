@@ -7,6 +7,7 @@
 // group from its caller's values reports bad input as before.
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -19,10 +20,18 @@ class NumericalDivergence : public std::invalid_argument {
 };
 
 /// A usable inverse-depth estimate: finite and positive, with a variance whose inverse is
-/// finite and positive too (regularisation weights by 1 / variance).
+/// finite and positive too (regularisation weights by 1 / variance). `inverse_variance` is
+/// 1 / variance, passed in by loops that have it already. Branch-free (NaN fails every
+/// comparison), so that such loops vectorise.
+inline bool HealthyEstimate(float idepth, float variance, float inverse_variance) {
+  constexpr float kMax = std::numeric_limits<float>::max();
+  return static_cast<bool>(static_cast<int>(idepth > 0.0f) & static_cast<int>(idepth <= kMax) &
+                           static_cast<int>(variance > 0.0f) & static_cast<int>(variance <= kMax) &
+                           static_cast<int>(inverse_variance <= kMax));
+}
+
 inline bool HealthyEstimate(float idepth, float variance) {
-  return std::isfinite(idepth) && idepth > 0.0f && std::isfinite(variance) && variance > 0.0f &&
-         std::isfinite(1.0f / variance);
+  return HealthyEstimate(idepth, variance, 1.0f / variance);
 }
 
 }  // namespace parallax

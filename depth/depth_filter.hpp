@@ -94,6 +94,12 @@ class DepthFilter {
   /// Kalman fusion of an observation with pixel (x, y)'s prior, or its rejection.
   void FuseObservation(InverseDepthMap* map, int x, int y, const StereoObservation& obs,
                        DepthUpdateStats* stats) const;
+  /// Regularize's first pass over row y: removes its unhealthy estimates (returns how many),
+  /// writes the kernel's inputs and the row's work lists (MapScratch).
+  int PrepareRegularizeRow(InverseDepthMap* map, int y) const;
+  /// Regularize's second pass: smooths the row's listed pixels and lists those to remove.
+  /// Reads the inputs of rows y - 2 to y + 2, so every row must be prepared first.
+  void RegularizeRow(InverseDepthMap* map, int y) const;
   /// Standard deviation below converged_relative_sigma of the inverse depth.
   bool Converged(const InverseDepthMap& map, std::size_t i) const;
   DepthFilterOptions options_;

@@ -60,6 +60,9 @@ InverseDepthMap::InverseDepthMap(std::shared_ptr<const Frame> keyframe,
   CheckArgument(keyframe_ != nullptr, "InverseDepthMap: keyframe is null");
   width_ = keyframe_->Level(0).Width();
   height_ = keyframe_->Level(0).Height();
+  // The regularisation lists columns as 16-bit numbers (MapScratch).
+  CheckArgument(width_ <= 65536,
+                "InverseDepthMap: images wider than 65536 pixels are not supported");
   const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
   idepth.assign(n, 0.0f);
   variance.assign(n, 0.0f);

@@ -38,8 +38,11 @@ class MapScratch {
 
   void Release() { *this = MapScratch{}; }
 
-  RegularizeInputs regularize;     ///< the kernel's per-pixel inputs
-  std::vector<std::uint8_t> keep;  ///< the regularisation's verdict per pixel
+  RegularizeInputs regularize;  ///< the kernel's per-pixel inputs
+  /// The regularisation's work lists per row (row y's entries start at y * width): the
+  /// columns of its valid pixels inside the 5x5 window's margin, and of those it removes.
+  std::vector<std::uint16_t> valid_columns, removed_columns;
+  std::vector<int> valid_in_row, removed_in_row;  ///< entries used per row
   /// Hole filling's window sums (support, inverse variance, inverse depth / variance) and
   /// its box filter's row sums.
   std::array<std::vector<float>, 4> fill;
