@@ -14,52 +14,7 @@
 namespace parallax {
 namespace {
 
-void Invalidate(InverseDepthMap* map, std::size_t i) {
-  map->valid[i] = 0;
-  map->validity[i] = 0.0f;
-  map->observations[i] = 0;
-}
-
 constexpr std::size_t Idx(int i) { return static_cast<std::size_t>(i); }
-
-// The regularisation's passes over a row are branch-free over raw pointers, so that they
-// vectorise: a third of the pixels are valid, in no predictable pattern. Invalid pixels'
-// quotients are computed and discarded.
-
-/// Valid estimates in the row from index `row` (w pixels) that are not healthy.
-int CountUnhealthy(const InverseDepthMap& map, std::size_t row, int w) {
-  const std::uint8_t* valid = &map.valid[row];
-  const float* idepth = &map.idepth[row];
-  const float* variance = &map.variance[row];
-  int unhealthy = 0;
-  for (int x = 0; x < w; ++x) {
-    const bool healthy = HealthyEstimate(idepth[x], variance[x]);
-    unhealthy += static_cast<int>((valid[x] != 0) & !healthy);
-  }
-  return unhealthy;
-}
-
-/// The kernel's inputs for the row from index `row`: 0 for invalid pixels.
-void FillRegularizeInputs(const InverseDepthMap& map, std::size_t row, int w,
-                          RegularizeInputs* in) {
-  const std::uint8_t* valid = &map.valid[row];
-  const std::uint16_t* observations = &map.observations[row];
-  const float* variance = &map.variance[row];
-  const float* validity = &map.validity[row];
-  float* inv_var = &in->inv_var[row];
-  float* support = &in->support[row];
-  float* vote = &in->vote[row];
-  // The quotients first: a division under a condition does not vectorise.
-  for (int x = 0; x < w; ++x) inv_var[x] = 1.0f / variance[x];
-  for (int x = 0; x < w; ++x) {
-    const bool is_valid = valid[x] != 0;
-    const float quotient = inv_var[x], own_validity = validity[x];  // unconditional loads
-    const float v = is_valid ? own_validity : 0.0f;
-    inv_var[x] = is_valid ? quotient : 0.0f;
-    support[x] = v;
-    vote[x] = observations[x] != 0 ? v : 0.0f;
-  }
-}
 
 /// In place: each pixel becomes the sum of the 5x5 window around it (pixels within 2 of the
 /// border, whose window leaves the image, become 0; callers skip them). Rows in parallel;
@@ -121,7 +76,7 @@ void DepthFilter::UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search
   ++stats->attempted;
   const bool has_prior = map->valid[i] != 0;
   if (has_prior && !HealthyEstimate(map->idepth[i], map->variance[i])) {
-    Invalidate(map, i);  // a diverged prior would steer the search with NaN bounds
+    map->Invalidate(i);  // a diverged prior would steer the search with NaN bounds
     ++stats->diverged;
     return;
   }
@@ -171,7 +126,7 @@ void DepthFilter::RecordFailure(InverseDepthMap* map, std::size_t i, bool has_pr
       map->validity[i] -= options_.validity_gain;
       map->variance[i] *= options_.inconsistency_variance_factor;
       if (map->variance[i] > options_.max_variance) {
-        Invalidate(map, i);
+        map->Invalidate(i);
         --map->blacklist[i];
         ++stats->dropped;
       }
@@ -214,7 +169,7 @@ void DepthFilter::FuseObservation(InverseDepthMap* map, int x, int y, const Ster
     map->variance[i] *= options_.inconsistency_variance_factor;
     map->validity[i] -= options_.validity_gain;
     if (map->variance[i] > options_.max_variance) {
-      Invalidate(map, i);
+      map->Invalidate(i);
       ++stats->dropped;
     }
     return;
@@ -223,7 +178,7 @@ void DepthFilter::FuseObservation(InverseDepthMap* map, int x, int y, const Ster
       (prior_var * obs.idepth + obs.variance * map->idepth[i]) / (prior_var + obs.variance);
   map->variance[i] = prior_var * obs.variance / (prior_var + obs.variance);
   if (!HealthyEstimate(map->idepth[i], map->variance[i])) {
-    Invalidate(map, i);
+    map->Invalidate(i);
     ++stats->diverged;
     return;
   }
@@ -250,104 +205,6 @@ DepthUpdateStats DepthFilter::Update(InverseDepthMap* map, const StereoFrame& fr
   for (const DepthUpdateStats& s : per_row) Add(&total, s);
   total.diverged += Regularize(map);
   return total;
-}
-
-int DepthFilter::Regularize(InverseDepthMap* map) const {
-  const int h = map->Height();
-  MapScratch& scratch = map->scratch;
-  const std::size_t n = map->valid.size();
-  // The kernel's inputs once per pixel (0 for invalid ones), and the distance decay as a
-  // table: the 5x5 window is then multiplications and masks only. The buffers are the map's,
-  // reused: every pixel is written below.
-  RegularizeInputs& in = scratch.regularize;
-  in.width = map->Width();
-  in.idepth = map->idepth.data();
-  in.variance = map->variance.data();
-  in.inv_var.resize(n);
-  in.support.resize(n);
-  in.vote.resize(n);
-  scratch.valid_columns.resize(n);
-  scratch.removed_columns.resize(n);
-  scratch.valid_in_row.assign(Idx(h), 0);
-  scratch.removed_in_row.assign(Idx(h), 0);
-  // Inverse variance, decaying mildly with distance (scale-free form of LSD's
-  // 1 / (var + dist^2 * REG_DIST_VAR)).
-  for (int dy = -2; dy <= 2; ++dy) {
-    for (int dx = -2; dx <= 2; ++dx)
-      in.decay[Idx((dy + 2) * 5 + dx + 2)] =
-          1.0f / (1.0f + 0.1f * static_cast<float>(dx * dx + dy * dy));
-  }
-  // Per pixel, so rows run in parallel; the count is summed in row order.
-  std::vector<int> diverged_in_row(Idx(h), 0);
-  tbb::parallel_for(0, h, [&](int y) { diverged_in_row[Idx(y)] = PrepareRegularizeRow(map, y); });
-  int diverged = 0;
-  for (const int count : diverged_in_row) diverged += count;
-  tbb::parallel_for(0, h, [&](int y) { RegularizeRow(map, y); });
-  // After every window has read its inputs: the removals change no other pixel's result.
-  tbb::parallel_for(0, h, [&](int y) {
-    const std::uint16_t* removed = &scratch.removed_columns[map->Index(0, y)];
-    for (int k = 0; k < scratch.removed_in_row[Idx(y)]; ++k)
-      Invalidate(map, map->Index(removed[k], y));
-  });
-  return diverged;
-}
-
-int DepthFilter::PrepareRegularizeRow(InverseDepthMap* map, int y) const {
-  MapScratch& scratch = map->scratch;
-  const int w = map->Width(), h = map->Height();
-  const std::size_t row = map->Index(0, y);
-  const int diverged = CountUnhealthy(*map, row, w);
-  if (diverged > 0) {  // rare
-    for (std::size_t i = row, end = row + Idx(w); i < end; ++i) {
-      if (map->valid[i] != 0 && !HealthyEstimate(map->idepth[i], map->variance[i]))
-        Invalidate(map, i);
-    }
-  }
-  FillRegularizeInputs(*map, row, w, &scratch.regularize);
-  const std::uint8_t* valid = &map->valid[row];
-  // The work lists: valid pixels inside the window's margin are regularised; valid ones on
-  // it (none where pixels are eligible only 3 or more from the border) are removed.
-  const bool inner_row = y >= 2 && y < h - 2;
-  std::uint16_t* inner = &scratch.valid_columns[row];
-  std::uint16_t* removed = &scratch.removed_columns[row];
-  int num_inner = 0, num_removed = 0;
-  for (int x0 = 0; x0 < w; x0 += 8) {
-    // Eight columns at a time; semi-dense maps have long runs without a valid pixel.
-    const int x1 = std::min(x0 + 8, w);
-    std::uint64_t eight = 1;
-    if (x1 - x0 == 8) std::memcpy(&eight, valid + x0, sizeof(eight));
-    if (eight == 0) continue;
-    for (int x = x0; x < x1; ++x) {
-      const bool is_valid = valid[x] != 0;
-      const bool is_inner = inner_row && x >= 2 && x < w - 2;
-      inner[num_inner] = removed[num_removed] = static_cast<std::uint16_t>(x);
-      num_inner += static_cast<int>(is_valid && is_inner);
-      num_removed += static_cast<int>(is_valid && !is_inner);
-    }
-  }
-  scratch.valid_in_row[Idx(y)] = num_inner;
-  scratch.removed_in_row[Idx(y)] = num_removed;
-  return diverged;
-}
-
-void DepthFilter::RegularizeRow(InverseDepthMap* map, int y) const {
-  MapScratch& scratch = map->scratch;
-  const std::size_t row = map->Index(0, y);
-  const std::uint16_t* inner = &scratch.valid_columns[row];
-  std::uint16_t* removed = &scratch.removed_columns[row];
-  int& num_removed = scratch.removed_in_row[Idx(y)];
-  for (int k = 0; k < scratch.valid_in_row[Idx(y)]; ++k) {
-    const std::size_t i = row + inner[k];
-    const RegularizedPixel r = RegularizePixelSimd(scratch.regularize, i);
-    map->idepth_smoothed[i] = r.idepth;
-    map->variance_smoothed[i] = r.variance;
-    // Removed: too little support around it, or observed neighbours mostly disagree (a
-    // wrong match that later observations within its own mu +- 2 sigma cannot correct).
-    const bool keep = r.support >= options_.min_neighbour_validity && !(r.disagree > r.agree) &&
-                      HealthyEstimate(r.idepth, r.variance);
-    removed[num_removed] = inner[k];
-    num_removed += static_cast<int>(!keep);
-  }
 }
 
 int DepthFilter::FillHoles(InverseDepthMap* map) const {

@@ -77,6 +77,14 @@ class InverseDepthMap {
   /// From a prior (sparse or dense): eligible pixels with prior idepth > 0 and variance > 0.
   void InitializeFromPrior(const ImageF& idepth, const ImageF& variance);
 
+  /// Removes pixel i's estimate (its validity and observation count go with it; its depth
+  /// and variance stay as the last values, unused).
+  void Invalidate(std::size_t i) {
+    valid[i] = 0;
+    validity[i] = 0.0f;
+    observations[i] = 0;
+  }
+
   std::size_t NumValid() const;
   std::size_t NumEligible() const;
   /// Mean smoothed inverse depth of valid pixels (0 if none).
