@@ -5,10 +5,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstring>
 
 #include "core/check.hpp"
 #include "core/divergence.hpp"
+#include "core/mask_scan.hpp"
 #include "depth/regularize_kernel.hpp"
 
 namespace parallax {
@@ -198,7 +198,9 @@ DepthUpdateStats DepthFilter::Update(InverseDepthMap* map, const StereoFrame& fr
   std::vector<DepthUpdateStats> per_row(static_cast<std::size_t>(map->Height()));
   tbb::parallel_for(0, map->Height(), [&](int y) {
     DepthUpdateStats& s = per_row[static_cast<std::size_t>(y)];
-    for (int x = 0; x < map->Width(); ++x) UpdatePixel(map, search, x, y, &s);
+    // About half the pixels are not eligible, in runs (a dilated gradient mask).
+    ForEachColumnNearMask(&map->eligible[map->Index(0, y)], 0, map->Width(),
+                          [&](int x) { UpdatePixel(map, search, x, y, &s); });
   });
   ++map->updates;
   DepthUpdateStats total;

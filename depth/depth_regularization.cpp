@@ -5,10 +5,10 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <cstring>
 #include <vector>
 
 #include "core/divergence.hpp"
+#include "core/mask_scan.hpp"
 #include "depth/depth_filter.hpp"
 #include "depth/regularize_kernel.hpp"
 
@@ -117,20 +117,14 @@ int DepthFilter::PrepareRegularizeRow(InverseDepthMap* map, int y) const {
   std::uint16_t* inner = &scratch.valid_columns[row];
   std::uint16_t* removed = &scratch.removed_columns[row];
   int num_inner = 0, num_removed = 0;
-  for (int x0 = 0; x0 < w; x0 += 8) {
-    // Eight columns at a time; semi-dense maps have long runs without a valid pixel.
-    const int x1 = std::min(x0 + 8, w);
-    std::uint64_t eight = 1;
-    if (x1 - x0 == 8) std::memcpy(&eight, valid + x0, sizeof(eight));
-    if (eight == 0) continue;
-    for (int x = x0; x < x1; ++x) {
-      const bool is_valid = valid[x] != 0;
-      const bool is_inner = inner_row && x >= 2 && x < w - 2;
-      inner[num_inner] = removed[num_removed] = static_cast<std::uint16_t>(x);
-      num_inner += static_cast<int>(is_valid && is_inner);
-      num_removed += static_cast<int>(is_valid && !is_inner);
-    }
-  }
+  // Semi-dense maps have long runs without a valid pixel.
+  ForEachColumnNearMask(valid, 0, w, [&](int x) {
+    const bool is_valid = valid[x] != 0;
+    const bool is_inner = inner_row && x >= 2 && x < w - 2;
+    inner[num_inner] = removed[num_removed] = static_cast<std::uint16_t>(x);
+    num_inner += static_cast<int>(is_valid && is_inner);
+    num_removed += static_cast<int>(is_valid && !is_inner);
+  });
   scratch.valid_in_row[Idx(y)] = num_inner;
   scratch.removed_in_row[Idx(y)] = num_removed;
   return diverged;

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <vector>
 
+#include "core/mask_scan.hpp"
+
 namespace parallax {
 
 double ParallaxMoments::ImageDistance(const Eigen::Vector3d& t_kf_frame) const {
@@ -32,9 +34,10 @@ ParallaxMoments ComputeParallaxMoments(const InverseDepthMap& map) {
     const double y = (v - camera.Cy()) / camera.Fy();
     RowSums s{};
     const std::size_t row = map.Index(0, v);
-    for (int u = 0; u < width; ++u) {
+    // Valid pixels are sparse and in runs.
+    ForEachColumnNearMask(&map.valid[row], 0, width, [&](int u) {
       const std::size_t i = row + static_cast<std::size_t>(u);
-      if (!map.valid[i]) continue;
+      if (!map.valid[i]) return;
       const double x = (u - camera.Cx()) * inv_fx;
       const double rho = map.idepth_smoothed[i];
       const double rho2 = rho * rho;
@@ -44,7 +47,7 @@ ParallaxMoments ComputeParallaxMoments(const InverseDepthMap& map) {
       s[3] += rho2 * x;
       s[4] += rho2 * y;
       s[5] += rho2 * (x * x + y * y);
-    }
+    });
     rows[static_cast<std::size_t>(v)] = s;
   });
   RowSums total{};

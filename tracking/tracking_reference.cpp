@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "core/check.hpp"
+#include "core/mask_scan.hpp"
 #include "tracking/tracking_result.hpp"
 
 namespace parallax {
@@ -121,17 +122,22 @@ Level0Scan ScanLevel0(const Frame& keyframe, const ReferenceDepth& depth,
     Level0Scan& scan = pairs[static_cast<std::size_t>(pair)];
     for (int y = std::max(2 * pair, b); y < std::min(2 * pair + 2, h - b); ++y) {
       const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
-      for (int x = b; x < w - b; ++x) {
+      const auto visit = [&](int x) {
         const std::size_t i = row + static_cast<std::size_t>(x);
         const float d = depth.idepth[i], var = depth.variance[i];
         const bool usable = (depth.valid == nullptr || depth.valid[i] != 0) && d > 0.0f &&
                             var > 0.0f && std::isfinite(d) && std::isfinite(var) &&
                             max_gradient(x, y) >= options.min_gradient;
-        if (!usable) continue;
+        if (!usable) return;
         if (keep) AddPoint(&scan.points, keyframe.Camera(0), level0, x, y, d, var);
         if (level1 != nullptr) level1->Add(x, y, d, var);
         scan.idepth_sum += d;
         ++scan.count;
+      };
+      if (depth.valid != nullptr) {
+        ForEachColumnNearMask(depth.valid + row, b, w - b, visit);  // valid: sparse, in runs
+      } else {
+        for (int x = b; x < w - b; ++x) visit(x);
       }
     }
   });
