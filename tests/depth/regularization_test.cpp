@@ -82,7 +82,8 @@ int ReferenceRegularize(const DepthFilterOptions& options, InverseDepthMap* map)
   }
   for (int dy = -2; dy <= 2; ++dy) {
     for (int dx = -2; dx <= 2; ++dx) {
-      in.decay[static_cast<std::size_t>((dy + 2) * 5 + dx + 2)] =
+      const int k = (dy + 2) * 5 + dx + 2;
+      in.decay[static_cast<std::size_t>(k)] =
           1.0f / (1.0f + 0.1f * static_cast<float>(dx * dx + dy * dy));
     }
   }
