@@ -21,31 +21,36 @@ constexpr std::size_t Idx(int i) { return static_cast<std::size_t>(i); }
 // vectorise: a third of the pixels are valid, in no predictable pattern. Invalid pixels'
 // quotients are computed and discarded.
 
-/// Valid estimates in the row from index `row` (w pixels) that are not healthy.
-int CountUnhealthy(const InverseDepthMap& map, std::size_t row, int w) {
+/// 1 / variance for every pixel of the row from index `row` (w pixels), into `inv_var`: a
+/// division under a condition does not vectorise.
+void InverseVariances(const InverseDepthMap& map, std::size_t row, int w, float* inv_var) {
+  const float* variance = &map.variance[row];
+  for (int x = 0; x < w; ++x) inv_var[x] = 1.0f / variance[x];
+}
+
+/// Valid estimates in the row that are not healthy, given the row's inverse variances.
+int CountUnhealthy(const InverseDepthMap& map, std::size_t row, int w, const float* inv_var) {
   const std::uint8_t* valid = &map.valid[row];
   const float* idepth = &map.idepth[row];
   const float* variance = &map.variance[row];
   int unhealthy = 0;
   for (int x = 0; x < w; ++x) {
-    const bool healthy = HealthyEstimate(idepth[x], variance[x]);
+    const bool healthy = HealthyEstimate(idepth[x], variance[x], inv_var[x]);
     unhealthy += static_cast<int>((valid[x] != 0) & !healthy);
   }
   return unhealthy;
 }
 
-/// The kernel's inputs for the row from index `row`: 0 for invalid pixels.
-void FillRegularizeInputs(const InverseDepthMap& map, std::size_t row, int w,
+/// The kernel's inputs for the row from its inverse variances (in in->inv_var): 0 for
+/// invalid pixels.
+void MaskRegularizeInputs(const InverseDepthMap& map, std::size_t row, int w,
                           RegularizeInputs* in) {
   const std::uint8_t* valid = &map.valid[row];
   const std::uint16_t* observations = &map.observations[row];
-  const float* variance = &map.variance[row];
   const float* validity = &map.validity[row];
   float* inv_var = &in->inv_var[row];
   float* support = &in->support[row];
   float* vote = &in->vote[row];
-  // The quotients first: a division under a condition does not vectorise.
-  for (int x = 0; x < w; ++x) inv_var[x] = 1.0f / variance[x];
   for (int x = 0; x < w; ++x) {
     const bool is_valid = valid[x] != 0;
     const float quotient = inv_var[x], own_validity = validity[x];  // unconditional loads
@@ -102,14 +107,17 @@ int DepthFilter::PrepareRegularizeRow(InverseDepthMap* map, int y) const {
   MapScratch& scratch = map->scratch;
   const int w = map->Width(), h = map->Height();
   const std::size_t row = map->Index(0, y);
-  const int diverged = CountUnhealthy(*map, row, w);
+  float* inv_var = &scratch.regularize.inv_var[row];
+  InverseVariances(*map, row, w, inv_var);
+  const int diverged = CountUnhealthy(*map, row, w, inv_var);
   if (diverged > 0) {  // rare
-    for (std::size_t i = row, end = row + Idx(w); i < end; ++i) {
-      if (map->valid[i] != 0 && !HealthyEstimate(map->idepth[i], map->variance[i]))
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = row + Idx(x);
+      if (map->valid[i] != 0 && !HealthyEstimate(map->idepth[i], map->variance[i], inv_var[x]))
         map->Invalidate(i);
     }
   }
-  FillRegularizeInputs(*map, row, w, &scratch.regularize);
+  MaskRegularizeInputs(*map, row, w, &scratch.regularize);
   const std::uint8_t* valid = &map->valid[row];
   // The work lists: valid pixels inside the window's margin are regularised; valid ones on
   // it (none where pixels are eligible only 3 or more from the border) are removed.
