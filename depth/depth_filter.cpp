@@ -3,13 +3,11 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 
 #include "core/check.hpp"
 #include "core/divergence.hpp"
 #include "core/mask_scan.hpp"
-#include "depth/regularize_kernel.hpp"
 
 namespace parallax {
 namespace {
