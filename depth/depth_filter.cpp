@@ -68,7 +68,7 @@ bool DepthFilter::Converged(const InverseDepthMap& map, std::size_t i) const {
 }
 
 void DepthFilter::UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search, int x, int y,
-                              DepthUpdateStats* stats) const {
+                              bool searchable, DepthUpdateStats* stats) const {
   const std::size_t i = map->Index(x, y);
   if (!map->eligible[i] || map->blacklist[i] < -1) return;
   ++stats->attempted;
@@ -83,6 +83,10 @@ void DepthFilter::UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search
   if (has_prior && Converged(*map, i) &&
       (static_cast<std::uint32_t>(i) + map->updates) % converged_recheck_ != 0) {
     ++stats->converged_skipped;
+    return;
+  }
+  if (!searchable) {  // what Observe would answer before searching
+    ++stats->skipped;
     return;
   }
   const StereoObservation obs = ObservePixel(*map, search, x, y, has_prior);
@@ -194,11 +198,14 @@ DepthUpdateStats DepthFilter::Update(InverseDepthMap* map, const StereoFrame& fr
                 "DepthFilter::Update: frame and keyframe sizes differ");
   const EpipolarSearch search(map->Keyframe(), frame, options_);
   std::vector<DepthUpdateStats> per_row(static_cast<std::size_t>(map->Height()));
+  map->scratch.searchable.resize(map->valid.size());  // every entry read is written below
   tbb::parallel_for(0, map->Height(), [&](int y) {
     DepthUpdateStats& s = per_row[static_cast<std::size_t>(y)];
+    std::uint8_t* searchable = &map->scratch.searchable[map->Index(0, y)];
+    search.MarkSearchableRow(y, searchable);
     // About half the pixels are not eligible, in runs (a dilated gradient mask).
     ForEachColumnNearMask(&map->eligible[map->Index(0, y)], 0, map->Width(),
-                          [&](int x) { UpdatePixel(map, search, x, y, &s); });
+                          [&](int x) { UpdatePixel(map, search, x, y, searchable[x] != 0, &s); });
   });
   ++map->updates;
   DepthUpdateStats total;

@@ -79,8 +79,9 @@ class DepthFilter {
   const DepthFilterOptions& Options() const { return options_; }
 
  private:
+  /// `searchable`: EpipolarSearch::MarkSearchableRow's answer for the pixel.
   void UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search, int x, int y,
-                   DepthUpdateStats* stats) const;
+                   bool searchable, DepthUpdateStats* stats) const;
   /// The epipolar search of pixel (x, y): within two sigma of its prior when it has one.
   StereoObservation ObservePixel(const InverseDepthMap& map, const EpipolarSearch& search, int x,
                                  int y, bool has_prior) const;

@@ -46,6 +46,8 @@ class MapScratch {
   /// Hole filling's window sums (support, inverse variance, inverse depth / variance) and
   /// its box filter's row sums.
   std::array<std::vector<float>, 4> fill;
+  /// A stereo update's per-pixel answer of EpipolarSearch::MarkSearchableRow.
+  std::vector<std::uint8_t> searchable;
   /// Arrays a new map built with this scratch takes instead of allocating its own.
   RecycledArrays recycled;
 };

@@ -14,6 +14,40 @@ constexpr int kMaxSamples = 256 + 2 * kPatternHalf;
 // Array index from a (non-negative) int position.
 constexpr std::size_t Idx(int i) { return static_cast<std::size_t>(i); }
 
+// The comparison's loops are branch-free, so that they vectorise across positions; each
+// position's sum is still taken in pattern order, so the results are those of a loop that
+// compares one position at a time.
+
+/// ssd[j] = sum over k of (samples[j + k] - pattern[k])^2, for j < num_positions.
+void SumsOfSquaredDifferences(const float* samples, int num_positions,
+                              const std::array<float, 2 * kPatternHalf + 1>& pattern, float* ssd) {
+  const float p0 = pattern[0], p1 = pattern[1], p2 = pattern[2], p3 = pattern[3], p4 = pattern[4];
+  for (int j = 0; j < num_positions; ++j) {
+    const float* s = samples + j;
+    const float d0 = s[0] - p0, d1 = s[1] - p1, d2 = s[2] - p2, d3 = s[3] - p3, d4 = s[4] - p4;
+    ssd[j] = d0 * d0 + d1 * d1 + d2 * d2 + d3 * d3 + d4 * d4;
+  }
+}
+
+/// Index of the first smallest of values[0, n), n >= 1 (NaNs are never smaller).
+int FirstMinimum(const float* values, int n) {
+  int best = 0;
+  for (int j = 1; j < n; ++j) {
+    if (values[j] < values[best]) best = j;
+  }
+  return best;
+}
+
+/// How many of values[0, n) are below `threshold` more than one position away from `centre`.
+/// Not inlined: inlined into Observe, GCC 12 no longer vectorises its first loop.
+[[gnu::noinline]] int CountBelowAwayFrom(const float* values, int n, float threshold, int centre) {
+  int below = 0;
+  for (int j = 0; j < n; ++j) below += static_cast<int>(values[j] < threshold);
+  for (int j = std::max(0, centre - 1); j <= std::min(n - 1, centre + 1); ++j)
+    below -= static_cast<int>(values[j] < threshold);
+  return below;
+}
+
 }  // namespace
 
 EpipolarSearch::EpipolarSearch(const Frame& keyframe, const StereoFrame& frame,
@@ -31,26 +65,61 @@ EpipolarSearch::EpipolarSearch(const Frame& keyframe, const StereoFrame& frame,
       offset_(frame.offset),
       line_sigma_sq_(options.epipolar_line_sigma * (1.0f + frame.tracking_quality_penalty) *
                      options.epipolar_line_sigma * (1.0f + frame.tracking_quality_penalty)),
+      line_geometry_{fx_,
+                     fy_,
+                     cx_,
+                     cy_,
+                     c_kf_.x(),
+                     c_kf_.y(),
+                     c_kf_.z(),
+                     options.min_gradient_along_line_sq,
+                     options.min_gradient_along_line_share},
       options_(options) {}
+
+// Branch-free (every quantity computed, the tests combined with &), so that
+// MarkSearchableRow's loop vectorises.
+inline EpipolarSearch::LineAtPixel EpipolarSearch::LineAt(const LineGeometry& g, int x, int y,
+                                                          float gx, float gy) {
+  LineAtPixel line{};
+  const float qx = (static_cast<float>(x) - g.cx) / g.fx,
+              qy = (static_cast<float>(y) - g.cy) / g.fy;
+  // Epipolar direction in the keyframe image (towards/away from the frame centre's image),
+  // normalised as Eigen's normalize() does it.
+  const float lx = g.fx * (qx * g.centre_z - g.centre_x),
+              ly = g.fy * (qy * g.centre_z - g.centre_y);
+  const float length_sq = lx * lx + ly * ly;
+  const float length = std::sqrt(length_sq);
+  line.direction_x = lx / length;
+  line.direction_y = ly / length;
+  line.gradient_along = gx * line.direction_x + gy * line.direction_y;
+  line.gradient_sq = gx * gx + gy * gy;
+  const float along_sq = line.gradient_along * line.gradient_along;
+  // A gradient (almost) perpendicular to the line carries no depth information.
+  line.searchable = !(length_sq < 1e-12f) & !(along_sq < g.min_along_sq) &
+                    !(along_sq < g.min_along_share * line.gradient_sq);
+  return line;
+}
+
+void EpipolarSearch::MarkSearchableRow(int y, std::uint8_t* searchable) const {
+  // Locals: the byte stores could alias members, which would then be reloaded every pixel.
+  const LineGeometry geometry = line_geometry_;
+  const float* dx = kf_.dx.Row(y);
+  const float* dy = kf_.dy.Row(y);
+  const int w = kf_.Width();
+  for (int x = 0; x < w; ++x)
+    searchable[x] = static_cast<std::uint8_t>(LineAt(geometry, x, y, dx[x], dy[x]).searchable);
+}
 
 StereoObservation EpipolarSearch::Observe(int x, int y, float min_idepth, float max_idepth,
                                           float expected_idepth, float max_length) const {
   StereoObservation out;
   const float w = static_cast<float>(frame_.Width()), h = static_cast<float>(frame_.Height());
+  const LineAtPixel line = LineAt(line_geometry_, x, y, kf_.dx(x, y), kf_.dy(x, y));
+  if (!line.searchable) return out;
+  const Eigen::Vector2f line_kf(line.direction_x, line.direction_y);
+  const float g_line = line.gradient_along, g_sq = line.gradient_sq;
   const Eigen::Vector3f q((static_cast<float>(x) - cx_) / fx_, (static_cast<float>(y) - cy_) / fy_,
                           1.0f);
-  // Epipolar direction in the keyframe image (towards/away from the frame centre's image).
-  Eigen::Vector2f line_kf(fx_ * (q.x() * c_kf_.z() - c_kf_.x()),
-                          fy_ * (q.y() * c_kf_.z() - c_kf_.y()));
-  if (line_kf.squaredNorm() < 1e-12f) return out;
-  line_kf.normalize();
-  const float gx = kf_.dx(x, y), gy = kf_.dy(x, y);
-  const float g_line = gx * line_kf.x() + gy * line_kf.y();
-  const float g_sq = gx * gx + gy * gy;
-  if (g_line * g_line < options_.min_gradient_along_line_sq ||
-      g_line * g_line < options_.min_gradient_along_line_share * g_sq) {
-    return out;  // gradient (almost) perpendicular to the line: no depth information
-  }
   // The search segment: projections of the ray at min and max inverse depth.
   const Eigen::Vector3f Rq = R_ * q;
   const auto project = [&](float d) -> Eigen::Vector2f {
@@ -145,18 +214,10 @@ StereoObservation EpipolarSearch::Observe(int x, int y, float min_idepth, float 
     }
     samples[Idx(j)] = InterpolateBilinear(frame_.intensity, p.x(), p.y());
   }
-  const int num_positions = num_samples - 2 * kPatternHalf;
+  const int num_positions = num_samples - 2 * kPatternHalf;  // >= 1
   std::array<float, kMaxSamples> ssd;  // NOLINT(cppcoreguidelines-pro-type-member-init)
-  int best = -1;
-  for (int j = 0; j < num_positions; ++j) {
-    float e = 0.0f;
-    for (int k = 0; k <= 2 * kPatternHalf; ++k) {
-      const float diff = samples[Idx(j + k)] - pattern[Idx(k)];
-      e += diff * diff;
-    }
-    ssd[Idx(j)] = e;
-    if (best < 0 || e < ssd[Idx(best)]) best = j;
-  }
+  SumsOfSquaredDifferences(samples.data(), num_positions, pattern, ssd.data());
+  const int best = FirstMinimum(ssd.data(), num_positions);
   out.search_length = s1 - s0;
   if ((best == 0 && far_end_open) || (best == num_positions - 1 && near_end_open) ||
       (positions > num_positions && best == num_positions - 1)) {
@@ -174,11 +235,10 @@ StereoObservation EpipolarSearch::Observe(int x, int y, float min_idepth, float 
     out.status = StereoStatus::kNoMatch;
     return out;
   }
-  for (int j = 0; j < num_positions; ++j) {
-    if (std::abs(j - best) > 1 && ssd[Idx(j)] < options_.ambiguity_ratio * best_ssd) {
-      out.status = StereoStatus::kAmbiguous;
-      return out;
-    }
+  if (CountBelowAwayFrom(ssd.data(), num_positions, options_.ambiguity_ratio * best_ssd, best) >
+      0) {
+    out.status = StereoStatus::kAmbiguous;
+    return out;
   }
   // Sub-pixel: vertex of the parabola through the SSD at best - 1, best, best + 1.
   float offset_px = 0.0f;

@@ -3,6 +3,7 @@
 // frame of known relative pose (docs/math/depth_filter.md).
 
 #include <Eigen/Core>
+#include <cstdint>
 
 #include "core/frame.hpp"
 #include "core/se3.hpp"
@@ -50,7 +51,29 @@ class EpipolarSearch {
   StereoObservation Observe(int x, int y, float min_idepth, float max_idepth, float expected_idepth,
                             float max_length) const;
 
+  /// For every pixel x of keyframe row y (x < width): searchable[x] = 0 where Observe(x, y, ...)
+  /// returns kSkipped before it searches (no epipolar direction there, or a gradient (almost)
+  /// perpendicular to it; docs/math/depth_filter.md), else 1. Observe's own test, bit for bit,
+  /// for a whole row in one loop that vectorises: a third of an update's pixels fail it.
+  void MarkSearchableRow(int y, std::uint8_t* searchable) const;
+
  private:
+  /// What Observe's first test needs: the keyframe camera, the frame centre in keyframe
+  /// coordinates and the gradient gates.
+  struct LineGeometry {
+    float fx, fy, cx, cy;
+    float centre_x, centre_y, centre_z;
+    float min_along_sq, min_along_share;
+  };
+  /// Observe's first test at keyframe pixel (x, y) of keyframe gradient (gx, gy).
+  struct LineAtPixel {
+    float direction_x, direction_y;  ///< the epipolar line's unit direction
+    float gradient_along;            ///< the gradient's component along it
+    float gradient_sq;               ///< |gradient|^2
+    bool searchable;
+  };
+  static LineAtPixel LineAt(const LineGeometry& geometry, int x, int y, float gx, float gy);
+
   const PyramidLevel& kf_;
   const PyramidLevel& frame_;
   float fx_, fy_, cx_, cy_;
@@ -59,6 +82,7 @@ class EpipolarSearch {
   Eigen::Vector3f c_kf_;  // frame centre in keyframe coordinates
   float gain_, offset_;
   float line_sigma_sq_;
+  LineGeometry line_geometry_;
   DepthFilterOptions options_;
 };
 

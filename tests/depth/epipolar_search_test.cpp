@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "core/validity_mask.hpp"
@@ -265,6 +266,44 @@ TEST_F(EpipolarSearchTest, RotationUncertaintyAddsToTheVariance) {
     ++unchanged;
   });
   EXPECT_GT(unchanged, 500);
+}
+
+// MarkSearchableRow answers, for a whole row at once, Observe's first test: 0 exactly where
+// Observe returns kSkipped before it searches. Checked on every pixel for a sideways, a
+// forward (epipole inside the image) and a turning motion, with a gate strict enough that
+// both answers occur, and the pattern's rescale gate opened wide, so that Observe's only
+// other kSkipped cannot occur.
+TEST_F(EpipolarSearchTest, SearchableRowIsObservesOwnSkipTest) {
+  const std::vector<SE3d> motions = {
+      SE3d(SO3d(), Eigen::Vector3d(0.03, 0.01, 0.0)),
+      SE3d(SO3d(), Eigen::Vector3d(0.002, -0.001, 0.05)),
+      SE3d(SO3d::Exp(Eigen::Vector3d(0.02, -0.03, 0.01)), Eigen::Vector3d(-0.02, 0.01, 0.02))};
+  DepthFilterOptions options;
+  options.min_gradient_along_line_share = 0.3f;
+  options.min_rescale = 1e-3f;
+  options.max_rescale = 1e3f;
+  for (const SE3d& T_kf_frame : motions) {
+    const auto frame = test::RenderTestFrame(*scene_, T_w_kf_ * T_kf_frame, 1);
+    const StereoFrame stereo{frame.get(), T_kf_frame.Inverse()};
+    const EpipolarSearch search(*keyframe_->frame, stereo, options);
+    const int w = keyframe_->frame->Level(0).Width(), h = keyframe_->frame->Level(0).Height();
+    std::vector<std::uint8_t> searchable(static_cast<std::size_t>(w));
+    int skipped = 0, searched = 0, disagree = 0;
+    for (int y = 3; y < h - 3; ++y) {
+      search.MarkSearchableRow(y, searchable.data());
+      for (int x = 3; x < w - 3; ++x) {
+        const bool observe_skips =
+            search.Observe(x, y, 0.2f, 0.6f, 0.35f, 30.0f).status == StereoStatus::kSkipped;
+        const bool marked = searchable[static_cast<std::size_t>(x)] != 0;
+        disagree += static_cast<int>(marked == observe_skips);
+        skipped += static_cast<int>(!marked);
+        searched += static_cast<int>(marked);
+      }
+    }
+    EXPECT_EQ(disagree, 0);
+    EXPECT_GT(skipped, 1000);
+    EXPECT_GT(searched, 1000);
+  }
 }
 
 }  // namespace
