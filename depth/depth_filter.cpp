@@ -63,32 +63,50 @@ DepthFilter::DepthFilter(const DepthFilterOptions& options)
   options_.Check();
 }
 
-bool DepthFilter::Converged(const InverseDepthMap& map, std::size_t i) const {
-  return map.variance[i] < converged_sigma_sq_ * map.idepth[i] * map.idepth[i];
+int DepthFilter::PlanRow(const InverseDepthMap& map, int y, const std::uint8_t* recheck_turn,
+                         std::uint8_t* plan, DepthUpdateStats* stats) const {
+  const std::size_t row = map.Index(0, y);
+  const std::uint8_t* eligible = &map.eligible[row];
+  const std::int16_t* blacklist = &map.blacklist[row];
+  const std::uint8_t* valid = &map.valid[row];
+  const float* idepth = &map.idepth[row];
+  const float* variance = &map.variance[row];
+  const float converged_sigma_sq = converged_sigma_sq_;
+  const int w = map.Width();  // a local: the byte stores could alias the map
+  int attempted = 0, diverged = 0, converged_skipped = 0, skipped = 0, planned = 0;
+  // Branch-free, so that it vectorises: every quantity is computed for every pixel (those of
+  // pixels without an estimate are discarded).
+  for (int x = 0; x < w; ++x) {
+    const float d = idepth[x], v = variance[x];
+    const bool attempt = (eligible[x] != 0) & (blacklist[x] >= -1);
+    const bool prior = valid[x] != 0;
+    const bool healthy = HealthyEstimate(d, v, 1.0f / v);
+    const bool converged = v < converged_sigma_sq * d * d;
+    // A diverged prior would steer the search with NaN bounds.
+    const bool is_diverged = attempt & prior & !healthy;
+    // In turn, one in converged_recheck_ of the converged estimates per update.
+    const bool not_its_turn = attempt & prior & healthy & converged & (recheck_turn[x] == 0);
+    const bool go_on = attempt & !is_diverged & !not_its_turn;
+    const bool observe = go_on & (plan[x] != 0);  // plan: MarkSearchableRow's answer
+    attempted += static_cast<int>(attempt);
+    diverged += static_cast<int>(is_diverged);
+    converged_skipped += static_cast<int>(not_its_turn);
+    skipped += static_cast<int>(go_on & !observe);  // what Observe would answer first
+    planned += static_cast<int>(observe | is_diverged);
+    plan[x] = static_cast<std::uint8_t>(static_cast<int>(observe) * kPlanObserve +
+                                        static_cast<int>(is_diverged) * kPlanInvalidate);
+  }
+  stats->attempted += attempted;
+  stats->diverged += diverged;
+  stats->converged_skipped += converged_skipped;
+  stats->skipped += skipped;
+  return planned;
 }
 
-void DepthFilter::UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search, int x, int y,
-                              bool searchable, DepthUpdateStats* stats) const {
+void DepthFilter::ObserveAndFuse(InverseDepthMap* map, const EpipolarSearch& search, int x, int y,
+                                 DepthUpdateStats* stats) const {
   const std::size_t i = map->Index(x, y);
-  if (!map->eligible[i] || map->blacklist[i] < -1) return;
-  ++stats->attempted;
   const bool has_prior = map->valid[i] != 0;
-  if (has_prior && !HealthyEstimate(map->idepth[i], map->variance[i])) {
-    map->Invalidate(i);  // a diverged prior would steer the search with NaN bounds
-    ++stats->diverged;
-    return;
-  }
-  // In turn, one in converged_recheck_ of the converged estimates per update (a map has
-  // fewer than 2^32 - pixels updates, so the 32-bit sum does not wrap).
-  if (has_prior && Converged(*map, i) &&
-      (static_cast<std::uint32_t>(i) + map->updates) % converged_recheck_ != 0) {
-    ++stats->converged_skipped;
-    return;
-  }
-  if (!searchable) {  // what Observe would answer before searching
-    ++stats->skipped;
-    return;
-  }
   const StereoObservation obs = ObservePixel(*map, search, x, y, has_prior);
   if (obs.status != StereoStatus::kOk) {
     RecordFailure(map, i, has_prior, obs.status, stats);
@@ -197,15 +215,32 @@ DepthUpdateStats DepthFilter::Update(InverseDepthMap* map, const StereoFrame& fr
                     frame.frame->Level(0).Height() == map->Height(),
                 "DepthFilter::Update: frame and keyframe sizes differ");
   const EpipolarSearch search(map->Keyframe(), frame, options_);
+  const int w = map->Width();
   std::vector<DepthUpdateStats> per_row(static_cast<std::size_t>(map->Height()));
-  map->scratch.searchable.resize(map->valid.size());  // every entry read is written below
+  // Whose turn a converged estimate's re-observation is: pixel i's when (i + updates) is a
+  // multiple of converged_recheck_ (a map has fewer than 2^32 - pixels updates, so the 32-bit
+  // sum does not wrap), i.e. recheck_turns[(row's start + updates) % recheck + x].
+  std::vector<std::uint8_t>& turns = map->scratch.recheck_turns;
+  turns.resize(Idx(w) + converged_recheck_);
+  for (std::size_t k = 0; k < turns.size(); ++k)
+    turns[k] = static_cast<std::uint8_t>(k % converged_recheck_ == 0);
+  map->scratch.update_plan.resize(map->valid.size());  // every entry read is written below
   tbb::parallel_for(0, map->Height(), [&](int y) {
     DepthUpdateStats& s = per_row[static_cast<std::size_t>(y)];
-    std::uint8_t* searchable = &map->scratch.searchable[map->Index(0, y)];
-    search.MarkSearchableRow(y, searchable);
-    // About half the pixels are not eligible, in runs (a dilated gradient mask).
-    ForEachColumnNearMask(&map->eligible[map->Index(0, y)], 0, map->Width(),
-                          [&](int x) { UpdatePixel(map, search, x, y, searchable[x] != 0, &s); });
+    const std::size_t row = map->Index(0, y);
+    std::uint8_t* plan = &map->scratch.update_plan[row];
+    search.MarkSearchableRow(y, plan);
+    const std::uint32_t phase =
+        (static_cast<std::uint32_t>(row) + map->updates) % converged_recheck_;
+    if (PlanRow(*map, y, &turns[phase], plan, &s) == 0) return;
+    // Most pixels end in the plan, in runs.
+    ForEachColumnNearMask(plan, 0, w, [&](int x) {
+      if (plan[x] == kPlanObserve) {
+        ObserveAndFuse(map, search, x, y, &s);
+      } else if (plan[x] == kPlanInvalidate) {
+        map->Invalidate(row + Idx(x));
+      }
+    });
   });
   ++map->updates;
   DepthUpdateStats total;

@@ -79,9 +79,16 @@ class DepthFilter {
   const DepthFilterOptions& Options() const { return options_; }
 
  private:
-  /// `searchable`: EpipolarSearch::MarkSearchableRow's answer for the pixel.
-  void UpdatePixel(InverseDepthMap* map, const EpipolarSearch& search, int x, int y,
-                   bool searchable, DepthUpdateStats* stats) const;
+  /// What a stereo update does at each pixel of row y (`plan`, on entry
+  /// EpipolarSearch::MarkSearchableRow's answer): kPlanObserve, kPlanInvalidate (a diverged
+  /// prior) or nothing (not eligible, blacklisted, a converged estimate whose turn it is not,
+  /// or nothing to search), counting the pixels it settles. recheck_turn[x] != 0: a converged
+  /// estimate at x is re-observed in this update. Returns the pixels left to act on.
+  int PlanRow(const InverseDepthMap& map, int y, const std::uint8_t* recheck_turn,
+              std::uint8_t* plan, DepthUpdateStats* stats) const;
+  /// The stereo observation of pixel (x, y) and its consequence for the pixel's estimate.
+  void ObserveAndFuse(InverseDepthMap* map, const EpipolarSearch& search, int x, int y,
+                      DepthUpdateStats* stats) const;
   /// The epipolar search of pixel (x, y): within two sigma of its prior when it has one.
   StereoObservation ObservePixel(const InverseDepthMap& map, const EpipolarSearch& search, int x,
                                  int y, bool has_prior) const;
@@ -101,8 +108,7 @@ class DepthFilter {
   /// Regularize's second pass: smooths the row's listed pixels and lists those to remove.
   /// Reads the inputs of rows y - 2 to y + 2, so every row must be prepared first.
   void RegularizeRow(InverseDepthMap* map, int y) const;
-  /// Standard deviation below converged_relative_sigma of the inverse depth.
-  bool Converged(const InverseDepthMap& map, std::size_t i) const;
+  static constexpr std::uint8_t kPlanObserve = 1, kPlanInvalidate = 2;
   DepthFilterOptions options_;
   float converged_sigma_sq_;
   std::uint32_t converged_recheck_;  ///< 32-bit: the modulo per converged pixel is cheaper

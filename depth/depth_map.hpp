@@ -46,8 +46,9 @@ class MapScratch {
   /// Hole filling's window sums (support, inverse variance, inverse depth / variance) and
   /// its box filter's row sums.
   std::array<std::vector<float>, 4> fill;
-  /// A stereo update's per-pixel answer of EpipolarSearch::MarkSearchableRow.
-  std::vector<std::uint8_t> searchable;
+  /// A stereo update's plan per pixel (DepthFilter::PlanRow) and whose turn a converged
+  /// estimate's re-observation is, by column.
+  std::vector<std::uint8_t> update_plan, recheck_turns;
   /// Arrays a new map built with this scratch takes instead of allocating its own.
   RecycledArrays recycled;
 };
