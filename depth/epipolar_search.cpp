@@ -29,6 +29,42 @@ void SumsOfSquaredDifferences(const float* samples, int num_positions,
   }
 }
 
+/// The segment's sample j at (x0 + t_j dx, y0 + t_j dy), t_j = s0 + (j - kPatternHalf), as
+/// InterpolateBilinear
+/// takes it apart: the top-left neighbour's index in a row-major image of width w and the
+/// weights of its right and lower neighbours. Positions inside the image (precondition).
+/// A loop of its own, which vectorises; the lookups follow in InterpolateAt.
+void SegmentPositions(float x0, float y0, float dx, float dy, float s0, int n, int w, int* corner,
+                      float* weight_x, float* weight_y) {
+  for (int j = 0; j < n; ++j) {
+    const float t = s0 + static_cast<float>(j - kPatternHalf);
+    const float x = x0 + t * dx, y = y0 + t * dy;
+    const int ix = static_cast<int>(x), iy = static_cast<int>(y);
+    weight_x[j] = x - static_cast<float>(ix);
+    weight_y[j] = y - static_cast<float>(iy);
+    corner[j] = iy * w + ix;
+  }
+}
+
+/// Whether mask[corner[j]] is 0 for some j < n.
+bool AnyZeroAt(const std::uint8_t* mask, const int* corner, int n) {
+  int zeros = 0;
+  for (int j = 0; j < n; ++j) zeros += static_cast<int>(mask[corner[j]] == 0);
+  return zeros > 0;
+}
+
+/// InterpolateBilinear's value at each of SegmentPositions' samples, bit for bit.
+void InterpolateAt(const float* image, int w, const int* corner, const float* weight_x,
+                   const float* weight_y, int n, float* samples) {
+  for (int j = 0; j < n; ++j) {
+    const float* row0 = image + corner[j];
+    const float* row1 = row0 + w;
+    const float fx = weight_x[j], fy = weight_y[j];
+    samples[j] = (1.0f - fy) * ((1.0f - fx) * row0[0] + fx * row0[1]) +
+                 fy * ((1.0f - fx) * row1[0] + fx * row1[1]);
+  }
+}
+
 /// Index of the first smallest of values[0, n), n >= 1 (NaNs are never smaller).
 int FirstMinimum(const float* values, int n) {
   int best = 0;
@@ -204,16 +240,18 @@ StereoObservation EpipolarSearch::Observe(int x, int y, float min_idepth, float 
   // Not value-initialised: only the first num_samples entries are written and read, and
   // zeroing 2 x 1 KB per pixel cost more than the search itself.
   std::array<float, kMaxSamples> samples;  // NOLINT(cppcoreguidelines-pro-type-member-init)
-  for (int j = 0; j < num_samples; ++j) {
-    const Eigen::Vector2f p = far + (s0 + static_cast<float>(j - kPatternHalf)) * dir;
-    // A window that reaches where the frame sees no input is cut as by the image border.
-    if (frame_.valid != nullptr &&
-        frame_.valid[static_cast<int>(p.y()) * frame_.Width() + static_cast<int>(p.x())] == 0) {
-      out.status = StereoStatus::kOutOfImage;
-      return out;
-    }
-    samples[Idx(j)] = InterpolateBilinear(frame_.intensity, p.x(), p.y());
+  std::array<int, kMaxSamples> corner;     // NOLINT(cppcoreguidelines-pro-type-member-init)
+  std::array<float, kMaxSamples> weight_x,
+      weight_y;  // NOLINT(cppcoreguidelines-pro-type-member-init)
+  SegmentPositions(far.x(), far.y(), dir.x(), dir.y(), s0, num_samples, frame_.Width(),
+                   corner.data(), weight_x.data(), weight_y.data());
+  // A window that reaches where the frame sees no input is cut as by the image border.
+  if (frame_.valid != nullptr && AnyZeroAt(frame_.valid, corner.data(), num_samples)) {
+    out.status = StereoStatus::kOutOfImage;
+    return out;
   }
+  InterpolateAt(frame_.intensity.Data(), frame_.Width(), corner.data(), weight_x.data(),
+                weight_y.data(), num_samples, samples.data());
   const int num_positions = num_samples - 2 * kPatternHalf;  // >= 1
   std::array<float, kMaxSamples> ssd;  // NOLINT(cppcoreguidelines-pro-type-member-init)
   SumsOfSquaredDifferences(samples.data(), num_positions, pattern, ssd.data());
