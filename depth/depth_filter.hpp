@@ -111,7 +111,7 @@ class DepthFilter {
   static constexpr std::uint8_t kPlanObserve = 1, kPlanInvalidate = 2;
   DepthFilterOptions options_;
   float converged_sigma_sq_;
-  std::uint32_t converged_recheck_;  ///< 32-bit: the modulo per converged pixel is cheaper
+  std::uint32_t converged_recheck_;  ///< 32-bit, as the map's update count it divides
 };
 
 }  // namespace parallax

@@ -29,11 +29,10 @@ void SumsOfSquaredDifferences(const float* samples, int num_positions,
   }
 }
 
-/// The segment's sample j at (x0 + t_j dx, y0 + t_j dy), t_j = s0 + (j - kPatternHalf), as
-/// InterpolateBilinear
-/// takes it apart: the top-left neighbour's index in a row-major image of width w and the
-/// weights of its right and lower neighbours. Positions inside the image (precondition).
-/// A loop of its own, which vectorises; the lookups follow in InterpolateAt.
+/// The segment's sample j at (x0 + t_j dx, y0 + t_j dy), t_j = s0 + (j - kPatternHalf), taken
+/// apart as InterpolateBilinear does it: the top-left neighbour's index in a row-major image of
+/// width w and the weights of its right and lower neighbours. Positions inside the image
+/// (precondition). A loop of its own, which vectorises; the lookups follow in InterpolateAt.
 void SegmentPositions(float x0, float y0, float dx, float dy, float s0, int n, int w, int* corner,
                       float* weight_x, float* weight_y) {
   for (int j = 0; j < n; ++j) {
@@ -238,11 +237,11 @@ StereoObservation EpipolarSearch::Observe(int x, int y, float min_idepth, float 
   const int positions = static_cast<int>(std::floor(s1 - s0)) + 1;
   const int num_samples = std::min(positions + 2 * kPatternHalf, kMaxSamples);
   // Not value-initialised: only the first num_samples entries are written and read, and
-  // zeroing 2 x 1 KB per pixel cost more than the search itself.
-  std::array<float, kMaxSamples> samples;  // NOLINT(cppcoreguidelines-pro-type-member-init)
-  std::array<int, kMaxSamples> corner;     // NOLINT(cppcoreguidelines-pro-type-member-init)
-  std::array<float, kMaxSamples> weight_x,
-      weight_y;  // NOLINT(cppcoreguidelines-pro-type-member-init)
+  // zeroing these 1 KB arrays for every pixel would cost more than the search itself.
+  std::array<float, kMaxSamples> samples;   // NOLINT(cppcoreguidelines-pro-type-member-init)
+  std::array<int, kMaxSamples> corner;      // NOLINT(cppcoreguidelines-pro-type-member-init)
+  std::array<float, kMaxSamples> weight_x;  // NOLINT(cppcoreguidelines-pro-type-member-init)
+  std::array<float, kMaxSamples> weight_y;  // NOLINT(cppcoreguidelines-pro-type-member-init)
   SegmentPositions(far.x(), far.y(), dir.x(), dir.y(), s0, num_samples, frame_.Width(),
                    corner.data(), weight_x.data(), weight_y.data());
   // A window that reaches where the frame sees no input is cut as by the image border.
