@@ -85,6 +85,22 @@ int FirstMinimum(const float* values, int n) {
 
 }  // namespace
 
+EpipolarSearch::LineGeometry EpipolarSearch::MakeLineGeometry(const PinholeCamera& camera,
+                                                              const SE3d& T_frame_kf,
+                                                              const DepthFilterOptions& options) {
+  // The frame centre in keyframe coordinates.
+  const Eigen::Vector3f centre = T_frame_kf.Inverse().Translation().cast<float>();
+  return {static_cast<float>(camera.Fx()),
+          static_cast<float>(camera.Fy()),
+          static_cast<float>(camera.Cx()),
+          static_cast<float>(camera.Cy()),
+          centre.x(),
+          centre.y(),
+          centre.z(),
+          options.min_gradient_along_line_sq,
+          options.min_gradient_along_line_share};
+}
+
 EpipolarSearch::EpipolarSearch(const Frame& keyframe, const StereoFrame& frame,
                                const DepthFilterOptions& options)
     : kf_(keyframe.Level(0)),
@@ -95,20 +111,11 @@ EpipolarSearch::EpipolarSearch(const Frame& keyframe, const StereoFrame& frame,
       cy_(static_cast<float>(keyframe.Camera(0).Cy())),
       R_(frame.T_frame_kf.RotationMatrix().cast<float>()),
       t_(frame.T_frame_kf.Translation().cast<float>()),
-      c_kf_(frame.T_frame_kf.Inverse().Translation().cast<float>()),
       gain_(frame.gain),
       offset_(frame.offset),
       line_sigma_sq_(options.epipolar_line_sigma * (1.0f + frame.tracking_quality_penalty) *
                      options.epipolar_line_sigma * (1.0f + frame.tracking_quality_penalty)),
-      line_geometry_{fx_,
-                     fy_,
-                     cx_,
-                     cy_,
-                     c_kf_.x(),
-                     c_kf_.y(),
-                     c_kf_.z(),
-                     options.min_gradient_along_line_sq,
-                     options.min_gradient_along_line_share},
+      line_geometry_(MakeLineGeometry(keyframe.Camera(0), frame.T_frame_kf, options)),
       options_(options) {}
 
 // Branch-free (every quantity computed, the tests combined with &), so that

@@ -73,13 +73,14 @@ class EpipolarSearch {
     bool searchable;
   };
   static LineAtPixel LineAt(const LineGeometry& geometry, int x, int y, float gx, float gy);
+  static LineGeometry MakeLineGeometry(const PinholeCamera& camera, const SE3d& T_frame_kf,
+                                       const DepthFilterOptions& options);
 
   const PyramidLevel& kf_;
   const PyramidLevel& frame_;
   float fx_, fy_, cx_, cy_;
   Eigen::Matrix3f R_;  // frame <- kf
   Eigen::Vector3f t_;
-  Eigen::Vector3f c_kf_;  // frame centre in keyframe coordinates
   float gain_, offset_;
   float line_sigma_sq_;
   LineGeometry line_geometry_;
