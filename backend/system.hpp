@@ -274,8 +274,11 @@ class System {
                                                       const TrackingResult& tracked);
   bool RandomStartAgrees(const SE3d& T_kf_frame, const TwoViewPair& pair) const;
   /// A frame posed before, tracked again on the current (refined) map from that pose
-  /// (FrameTracker::Retrack); nullopt when lost.
-  std::optional<SE3d> TrackAgain(const Frame& frame, const SE3d& guess);
+  /// (FrameTracker::Retrack); nullopt when lost. `previous`: the result of the frame before it,
+  /// tracked again just before; when this one explains clearly fewer points, the frame is also
+  /// tracked from that frame's pose and the result that explains more is kept.
+  std::optional<TrackingResult> TrackAgain(const Frame& frame, const SE3d& guess,
+                                           const std::optional<TrackingResult>& previous);
   void BufferInitialFrame(const std::shared_ptr<const Frame>& frame, const SE3d& T_kf_frame);
   /// Replaces the first keyframe's depth by stereo with the pair's frame (in initial_frames_)
   /// and tracks every buffered frame again; returns their revised poses, the last one being

@@ -3,12 +3,21 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <utility>
 
 #include "backend/system.hpp"
 #include "core/angles.hpp"
 
 namespace parallax {
+namespace {
+
+std::optional<SE3d> PoseOf(const std::optional<TrackingResult>& tracked) {
+  if (!tracked) return std::nullopt;
+  return tracked->T_kf_frame;
+}
+
+}  // namespace
 
 FrameResult System::StartFirstKeyframe(const std::shared_ptr<const Frame>& frame,
                                        const ImageU8& image) {
@@ -71,11 +80,24 @@ void System::BufferInitialFrame(const std::shared_ptr<const Frame>& frame, const
   }
 }
 
-std::optional<SE3d> System::TrackAgain(const Frame& frame, const SE3d& guess) {
-  const TrackingResult again =
+std::optional<TrackingResult> System::TrackAgain(const Frame& frame, const SE3d& guess,
+                                                 const std::optional<TrackingResult>& previous) {
+  TrackingResult again =
       tracker_.Retrack(*mapper_.Reference(), frame, guess, tracker_.State().affine);
+  // Consecutive frames see nearly the same points: a result that explains clearly fewer than
+  // the frame before it did is in another basin, which the guess may have led it into
+  // (docs/math/tracking.md, "Tracking the start's frames again").
+  const double margin = options_.tracker.refine_margin;
+  if (previous && (again.status == TrackingStatus::kLost ||
+                   again.stats.points_good < (1.0 - margin) * previous->stats.points_good)) {
+    TrackingResult from_previous =
+        tracker_.Retrack(*mapper_.Reference(), frame, previous->T_kf_frame, previous->affine);
+    if (ExplainsMore(from_previous, again, margin * again.stats.points_in_view)) {
+      again = std::move(from_previous);
+    }
+  }
   if (again.status == TrackingStatus::kLost) return std::nullopt;
-  return again.T_kf_frame;
+  return again;
 }
 
 std::vector<RevisedPose> System::FinishInitialisation() {
@@ -106,8 +128,11 @@ std::vector<RevisedPose> System::FinishInitialisation() {
   if (!replaced) {
     if (!poses) {
       poses.emplace();
-      for (const auto& [frame, T_kf_frame] : initial_frames_)
-        poses->push_back(TrackAgain(*frame, T_kf_frame));
+      std::optional<TrackingResult> previous;
+      for (const auto& [frame, T_kf_frame] : initial_frames_) {
+        previous = TrackAgain(*frame, T_kf_frame, previous);
+        poses->push_back(PoseOf(previous));
+      }
     }
     RefineStart(&*poses);
     for (std::size_t i = 0; i < initial_frames_.size(); ++i) {

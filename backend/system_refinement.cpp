@@ -48,10 +48,10 @@ void System::RefineStart(BufferedPoses* poses) {
   SetEstimates(pixel, r.idepth, r.idepth);
   // Every buffered frame tracked against the refined depth (the refined poses as guesses).
   for (std::size_t j = 0; j < index.size(); ++j) (*poses)[index[j]] = r.T_kf_frame[j];
+  std::optional<TrackingResult> previous;
   for (const std::size_t i : posed) {
-    if (const auto again = TrackAgain(*initial_frames_[i].first, *(*poses)[i])) {
-      (*poses)[i] = again;
-    }
+    previous = TrackAgain(*initial_frames_[i].first, *(*poses)[i], previous);
+    if (previous) (*poses)[i] = previous->T_kf_frame;
   }
 }
 
