@@ -10,6 +10,7 @@
 #include "core/check.hpp"
 #include "tracking/levenberg_marquardt.hpp"
 #include "tracking/photometric_batch.hpp"
+#include "tracking/photometric_lane_sums.hpp"
 #include "tracking/photometric_residual.hpp"
 #include "tracking/tracking_quality.hpp"
 
@@ -24,28 +25,27 @@ struct EvaluatedProblem : LinearizedProblem<8> {
   Se3Tracker::LevelEvaluation evaluation;
 };
 
-// Points [first, end) of a level, added in point order (tracking/photometric_batch.hpp).
+// Points [first, end) of a level, four at a time in four lanes of sums
+// (tracking/photometric_lane_sums.hpp).
 void EvaluateBlock(const PyramidLevel& image, const LevelCamera& camera,
                    const PhotometricModel& model, const ReferenceLevel& points, float good_sq,
                    std::size_t first, std::size_t end, Se3Tracker::LevelEvaluation* sum) {
-  BlockAccumulator<8> accumulator;
-  const auto add = [&](std::size_t i, const Eigen::Vector3f& dr_dp, const Eigen::Vector3f& p,
-                       float residual, float variance, float gradient_sq, const RobustWeight& w) {
-    Eigen::Matrix<float, 8, 1> J;
-    J.head<3>() = dr_dp;
-    J.segment<3>(3) = p.cross(dr_dp);
-    J[6] = -model.gain * points.intensity[i];
-    J[7] = -1.0f;
-    accumulator.Add(J, residual, w.weight, w.cost);
-    ++sum->in_view;
-    sum->good += residual * residual < good_sq * variance;
-    sum->sum_sq_residual += static_cast<double>(residual) * residual;
-    sum->sum_gradient_sq += gradient_sq;
-  };
   const PhotometricPoints soa{points.ray_x.data(), points.ray_y.data(), points.idepth.data(),
                               points.variance.data(), points.intensity.data()};
-  ForEachPhotometricTerm(image, camera, model, soa, first, end, add);
-  accumulator.FlushInto(&sum->equations);
+  Se3LaneSums lanes;
+  PhotometricBatch batch;
+  std::size_t i = first;
+  for (; i + 4 <= end; i += 4) {
+    EvaluatePhotometric4(image, camera, model, soa, i, &batch);
+    if (batch.in_view != 0) AddSe3Batch(batch, soa.ref_intensity + i, model.gain, good_sq, &lanes);
+  }
+  if (i < end) {
+    float ref_intensity[4];
+    EvaluatePhotometricTail(image, camera, model, soa, i, end - i, &batch, ref_intensity);
+    if (batch.in_view != 0) AddSe3Batch(batch, ref_intensity, model.gain, good_sq, &lanes);
+  }
+  ReduceLaneSums(lanes, &sum->equations, &sum->in_view, &sum->good, &sum->sum_sq_residual,
+                 &sum->sum_gradient_sq);
 }
 
 }  // namespace

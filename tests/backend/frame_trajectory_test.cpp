@@ -147,12 +147,14 @@ TEST(FrameWorldPoses, AKeyframeWhoseOwnTrackingSlippedDoesNotMoveTheFramesBefore
   }
 }
 
-// The 300-frame room orbit of seed 2: the camera returns near its start, a neighbour edge
-// there corrects the heading by a few degrees and the graph spreads that over the chain.
-// Kept rigidly on their keyframes the frames show each keyframe's share as a step (the
-// largest per-frame error 70 mm where the median is under 1 mm); spread, they do not.
+// The 300-frame room orbit of seed 1: the camera returns near its start, a neighbour edge
+// there corrects the heading and the graph spreads that over the chain. Kept rigidly on their
+// keyframes the frames show each keyframe's share as a step (the largest per-frame error
+// 43-45 mm where the median is under 1 mm); spread, they do not. (Seed 2, used until
+// 2026-12-06, has such a correction or none depending on the tracker's float rounding: 70
+// mm, then 2.8 mm after the four-lane sums; seed 1 has it under both.)
 double LargestPerFrameError(bool spread) {
-  const synth::SynthOptions synth_options = test::RoomOrbit(300, 2);
+  const synth::SynthOptions synth_options = test::RoomOrbit(300, 1);
   const synth::Scene scene = synth::MakeScene(synth_options.scene, synth_options.seed);
   // The keyframe rule this was measured with (with today's, the graph moves this orbit's
   // keyframes by millimetres: no steps to remove, so nothing to test).
@@ -179,8 +181,8 @@ TEST(FrameWorldPosesInThePipeline, AnOrbitsTrajectoryHasNoStepsAtItsKeyframes) {
   const double rigid = LargestPerFrameError(false);
   RecordProperty("largest_per_frame_error_spread_mm", std::to_string(1000.0 * spread));
   RecordProperty("largest_per_frame_error_rigid_mm", std::to_string(1000.0 * rigid));
-  EXPECT_LT(spread, 0.01);  // measured 4.8 mm
-  EXPECT_GT(rigid, 0.03);   // measured 70 mm: the steps this removes
+  EXPECT_LT(spread, 0.01);  // measured 6.9-7.0 mm
+  EXPECT_GT(rigid, 0.03);   // measured 43-45 mm: the steps this removes
 }
 
 }  // namespace
