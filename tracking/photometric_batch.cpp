@@ -12,55 +12,24 @@ __m128 Select(__m128 mask, __m128 if_true, __m128 if_false) {
   return _mm_or_ps(_mm_and_ps(mask, if_true), _mm_andnot_ps(mask, if_false));
 }
 
-// The two floats at p[0], p[1] in lanes 0 and 1.
-__m128 LoadPair(const float* p) { return _mm_castsi128_ps(_mm_loadu_si64(p)); }
-
-// InterpolateBilinear's operations on four lanes: `offset` is each lane's top-left pixel
-// (row-major, the rows `width` floats apart), (fx, fy) its position within the 2x2 block.
-__m128 Bilinear(const float* plane, int width, const int offset[4], __m128 fx, __m128 fy) {
-  // Lanes (a, b) of the top row and (c, d) of the bottom row: a b / c d.
-  const auto row = [&](int down, __m128* left, __m128* right) {
-    const __m128 low = _mm_movelh_ps(LoadPair(plane + offset[0] + down),
-                                     LoadPair(plane + offset[1] + down));  // l0 r0 l1 r1
-    const __m128 high =
-        _mm_movelh_ps(LoadPair(plane + offset[2] + down), LoadPair(plane + offset[3] + down));
-    *left = _mm_shuffle_ps(low, high, _MM_SHUFFLE(2, 0, 2, 0));
-    *right = _mm_shuffle_ps(low, high, _MM_SHUFFLE(3, 1, 3, 1));
-  };
-  __m128 a, b, c, d;
-  row(0, &a, &b);
-  row(width, &c, &d);
-  const __m128 one = Splat(1.0f);
-  const __m128 gx = _mm_sub_ps(one, fx), gy = _mm_sub_ps(one, fy);
-  // (1 - fy) ((1 - fx) a + fx b) + fy ((1 - fx) c + fx d), as the scalar lookup.
-  return _mm_add_ps(_mm_mul_ps(gy, _mm_add_ps(_mm_mul_ps(gx, a), _mm_mul_ps(fx, b))),
-                    _mm_mul_ps(fy, _mm_add_ps(_mm_mul_ps(gx, c), _mm_mul_ps(fx, d))));
-}
-
-// The bilinear lookups (intensity and gradient) at (u, v) of the lanes in `in_view` (all bits
-// of a lane set), four at a time; returns the lanes' bits without those where the frame sees
-// no input (as outside the image). Lanes out of view read the pixel (1, 1) instead, so that
-// every lane loads something valid and none branches; their results are unspecified.
-unsigned LookUp(const PyramidLevel& frame, __m128 u, __m128 v, __m128 in_view, __m128* intensity,
-                __m128* gx, __m128* gy) {
-  const __m128 one = Splat(1.0f);
-  const __m128 safe_u = Select(in_view, u, one), safe_v = Select(in_view, v, one);
-  const __m128i x0 = _mm_cvttps_epi32(safe_u), y0 = _mm_cvttps_epi32(safe_v);
-  const __m128 fx = _mm_sub_ps(safe_u, _mm_cvtepi32_ps(x0));
-  const __m128 fy = _mm_sub_ps(safe_v, _mm_cvtepi32_ps(y0));
-  alignas(16) int x[4], y[4];
-  _mm_store_si128(reinterpret_cast<__m128i*>(x), x0);
-  _mm_store_si128(reinterpret_cast<__m128i*>(y), y0);
-  const int width = frame.Width();
-  int offset[4];
-  auto mask = static_cast<unsigned>(_mm_movemask_ps(in_view));
+// The scalar bilinear lookups (intensity and gradient) of the lanes in `mask` at (u, v);
+// returns the mask without the lanes where the frame sees no input (as outside the image).
+unsigned LookUp(const PyramidLevel& frame, __m128 u, __m128 v, unsigned mask, float* intensity,
+                float* gx, float* gy) {
+  alignas(16) float u_lane[4], v_lane[4];
+  _mm_store_ps(u_lane, u);
+  _mm_store_ps(v_lane, v);
   for (int k = 0; k < 4; ++k) {
-    offset[k] = y[k] * width + x[k];
-    if (frame.valid != nullptr && frame.valid[offset[k]] == 0) mask &= ~(1u << k);
+    if ((mask & (1u << k)) == 0) continue;
+    const int x = static_cast<int>(u_lane[k]), y = static_cast<int>(v_lane[k]);
+    if (frame.valid != nullptr && frame.valid[y * frame.Width() + x] == 0) {
+      mask &= ~(1u << k);
+      continue;
+    }
+    intensity[k] = InterpolateBilinear(frame.intensity, u_lane[k], v_lane[k]);
+    gx[k] = InterpolateBilinear(frame.dx, u_lane[k], v_lane[k]);
+    gy[k] = InterpolateBilinear(frame.dy, u_lane[k], v_lane[k]);
   }
-  *intensity = Bilinear(frame.intensity.Data(), width, offset, fx, fy);
-  *gx = Bilinear(frame.dx.Data(), width, offset, fx, fy);
-  *gy = Bilinear(frame.dy.Data(), width, offset, fx, fy);
   return mask;
 }
 
@@ -79,7 +48,7 @@ void StoreHuber(__m128 residual, __m128 variance, float huber_k, PhotometricBatc
 }  // namespace
 
 // Every expression below mirrors one of EvaluatePhotometric / HuberWeight, operand order
-// included (IEEE addition is not associative), and so do the bilinear lookups.
+// included (IEEE addition is not associative); the bilinear lookups are the scalar ones.
 void EvaluatePhotometric4(const PyramidLevel& frame, const LevelCamera& camera,
                           const PhotometricModel& model, const PhotometricPoints& points,
                           std::size_t first, PhotometricBatch* out) {
@@ -103,14 +72,12 @@ void EvaluatePhotometric4(const PyramidLevel& frame, const LevelCamera& camera,
   const __m128 inside = _mm_and_ps(
       _mm_and_ps(_mm_cmpge_ps(u, one), _mm_cmpge_ps(v, one)),
       _mm_and_ps(_mm_cmplt_ps(u, Splat(camera.max_u)), _mm_cmplt_ps(v, Splat(camera.max_v))));
-  const __m128 in_view = _mm_and_ps(in_front, inside);
-  if (_mm_movemask_ps(in_view) == 0) {
-    out->in_view = 0;
-    return;
-  }
-  __m128 I, g_x, g_y;
-  out->in_view = LookUp(frame, u, v, in_view, &I, &g_x, &g_y);
-  if (out->in_view == 0) return;
+  auto mask = static_cast<unsigned>(_mm_movemask_ps(_mm_and_ps(in_front, inside)));
+  alignas(16) float intensity[4] = {}, gx[4] = {}, gy[4] = {};
+  mask = LookUp(frame, u, v, mask, intensity, gx, gy);
+  out->in_view = mask;
+  if (mask == 0) return;
+  const __m128 I = _mm_load_ps(intensity), g_x = _mm_load_ps(gx), g_y = _mm_load_ps(gy);
   const __m128 z = _mm_div_ps(one, _mm_mul_ps(idepth, inv_z));
   const __m128 z_inv = _mm_mul_ps(idepth, inv_z);
   const __m128 a0 = _mm_mul_ps(_mm_mul_ps(g_x, Splat(camera.fx)), z_inv);
