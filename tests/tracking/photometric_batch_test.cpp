@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <memory>
 #include <random>
@@ -29,6 +30,18 @@ std::shared_ptr<const Frame> TexturedFrame() {
   }
   return std::make_shared<const Frame>(0, 0.0, PinholeCamera(160, 120, 120, 120, 79.5, 59.5), image,
                                        PyramidOptions{1, 8});
+}
+
+std::uint32_t Bits(float x) {
+  std::uint32_t bits = 0;
+  std::memcpy(&bits, &x, sizeof(bits));
+  return bits;
+}
+
+std::uint64_t Bits(double x) {
+  std::uint64_t bits = 0;
+  std::memcpy(&bits, &x, sizeof(bits));
+  return bits;
 }
 
 // Eight random points and a random warp: some points behind the camera, some outside the
@@ -167,7 +180,17 @@ TEST(PhotometricBatchTest, LaneSumsEqualTheScalarTwinAndThePointByPointEquations
       }
     }
   }
-  ASSERT_EQ(std::memcmp(&simd, &scalar, sizeof(Se3LaneSums)), 0);
+  // Bit for bit (a float comparison would take -0 for +0 and fail on NaN).
+  const auto expect_same_bits = [](const auto& a, const auto& b) {
+    for (int k = 0; k < 4; ++k) EXPECT_EQ(Bits(a[k]), Bits(b[k])) << k;
+  };
+  for (int k = 0; k < Se3LaneSums::kEntries; ++k) expect_same_bits(simd.H[k], scalar.H[k]);
+  for (int k = 0; k < 8; ++k) expect_same_bits(simd.g[k], scalar.g[k]);
+  expect_same_bits(simd.cost, scalar.cost);
+  expect_same_bits(simd.sum_sq_residual, scalar.sum_sq_residual);
+  expect_same_bits(simd.sum_gradient_sq, scalar.sum_gradient_sq);
+  EXPECT_EQ(simd.in_view, scalar.in_view);
+  EXPECT_EQ(simd.good, scalar.good);
   NormalEquations<8> reduced;
   int in_view = 0, good = 0;
   double sq_residual = 0.0, gradient_sq = 0.0;
