@@ -86,7 +86,7 @@ std::optional<TrackingResult> System::TrackAgain(const Frame& frame, const SE3d&
       tracker_.Retrack(*mapper_.Reference(), frame, guess, tracker_.State().affine);
   // Consecutive frames see nearly the same points: a result that explains clearly fewer than
   // the frame before it did is in another basin, which the guess may have led it into
-  // (docs/math/tracking.md, "Tracking the start's frames again").
+  // (docs/math/tracking.md, "Tracking the start's frames again from the frame before").
   const double margin = options_.tracker.refine_margin;
   if (previous && (again.status == TrackingStatus::kLost ||
                    again.stats.points_good < (1.0 - margin) * previous->stats.points_good)) {

@@ -3,7 +3,7 @@
 #include <emmintrin.h>
 
 #include <algorithm>
-#include <bitset>
+#include <bit>
 
 namespace parallax {
 namespace {
@@ -73,9 +73,8 @@ void AddSe3Batch(const PhotometricBatch& batch, const float* ref_intensity, floa
   AddInDouble(LoadMasked(batch.gradient_sq, mask), sums->sum_gradient_sq);
   const __m128 good =
       _mm_cmplt_ps(_mm_mul_ps(r, r), _mm_mul_ps(_mm_set1_ps(good_sq), _mm_load_ps(batch.variance)));
-  sums->good += static_cast<int>(
-      std::bitset<4>(static_cast<unsigned>(_mm_movemask_ps(_mm_and_ps(good, mask)))).count());
-  sums->in_view += static_cast<int>(std::bitset<4>(batch.in_view).count());
+  sums->good += std::popcount(static_cast<unsigned>(_mm_movemask_ps(_mm_and_ps(good, mask))));
+  sums->in_view += std::popcount(batch.in_view);
 }
 
 void AddSe3BatchScalar(const PhotometricBatch& batch, const float* ref_intensity, float gain,
