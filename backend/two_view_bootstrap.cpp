@@ -3,12 +3,14 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "backend/orb_matching.hpp"
 #include "backend/relative_pose_refinement.hpp"
 #include "backend/two_view_ambiguity.hpp"
 #include "core/angles.hpp"
@@ -21,7 +23,7 @@ struct TwoViewBootstrap::Impl {
   TwoViewBootstrapOptions options;
   cv::Ptr<cv::ORB> orb;
   std::vector<cv::KeyPoint> ref_keypoints;
-  cv::Mat ref_descriptors;
+  std::vector<OrbDescriptor> ref_descriptors;
   ImageU8 ref_image;
 };
 
@@ -87,12 +89,22 @@ void FitBrightness(const std::vector<double>& a, const std::vector<double>& b, T
   pair->gain = static_cast<float>(gain);
   pair->offset = static_cast<float>(mean_b - gain * mean_a);
 }
+
+/// OpenCV's descriptor rows (32 bytes each) as OrbDescriptors.
+std::vector<OrbDescriptor> ToDescriptors(const cv::Mat& rows) {
+  std::vector<OrbDescriptor> descriptors(static_cast<std::size_t>(rows.rows));
+  for (int i = 0; i < rows.rows; ++i)
+    std::memcpy(descriptors[static_cast<std::size_t>(i)].data(), rows.ptr(i),
+                sizeof(OrbDescriptor));
+  return descriptors;
+}
 }  // namespace
 
 void TwoViewBootstrap::SetReference(const ImageU8& image) {
   impl_->ref_keypoints.clear();
-  impl_->orb->detectAndCompute(Wrap(image), cv::noArray(), impl_->ref_keypoints,
-                               impl_->ref_descriptors);
+  cv::Mat descriptors;
+  impl_->orb->detectAndCompute(Wrap(image), cv::noArray(), impl_->ref_keypoints, descriptors);
+  impl_->ref_descriptors = ToDescriptors(descriptors);
   impl_->ref_image = image;
 }
 
@@ -104,16 +116,19 @@ struct Matches {
 
 /// Lowe-ratio-filtered ORB matches from the reference to the frame.
 Matches MatchFeatures(const std::vector<cv::KeyPoint>& ref_keypoints,
-                      const cv::Mat& ref_descriptors, const std::vector<cv::KeyPoint>& keypoints,
-                      const cv::Mat& descriptors, float ratio_test) {
-  cv::BFMatcher matcher(cv::NORM_HAMMING);
-  std::vector<std::vector<cv::DMatch>> knn;
-  matcher.knnMatch(ref_descriptors, descriptors, knn, 2);
+                      const std::vector<OrbDescriptor>& ref_descriptors,
+                      const std::vector<cv::KeyPoint>& keypoints, const cv::Mat& descriptors,
+                      float ratio_test) {
+  const std::vector<NearestTwo> nearest =
+      NearestTwoByHamming(ref_descriptors, ToDescriptors(descriptors));
   Matches matches;
-  for (const auto& m : knn) {
-    if (m.size() == 2 && m[0].distance < ratio_test * m[1].distance) {
-      matches.ref.push_back(ref_keypoints[static_cast<std::size_t>(m[0].queryIdx)].pt);
-      matches.cur.push_back(keypoints[static_cast<std::size_t>(m[0].trainIdx)].pt);
+  for (std::size_t i = 0; i < nearest.size(); ++i) {
+    const NearestTwo& m = nearest[i];
+    // In float, as the ratio was compared when it was chosen (with OpenCV's DMatch).
+    if (m.second >= 0 && static_cast<float>(m.nearest_distance) <
+                             ratio_test * static_cast<float>(m.second_distance)) {
+      matches.ref.push_back(ref_keypoints[i].pt);
+      matches.cur.push_back(keypoints[static_cast<std::size_t>(m.nearest)].pt);
     }
   }
   return matches;
