@@ -7,6 +7,7 @@
 #include <exception>
 
 #include "tools/commands/commands.hpp"
+#include "tools/huge_page_heap.hpp"
 
 namespace {
 
@@ -35,6 +36,8 @@ int Run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Before anything else: this may execute the program again (tools/huge_page_heap.hpp).
+  parallax::RestartWithHugePageHeap(argv);
   // Frame pyramids, depth maps and their scratch images (about 1 MB each at 640x480) are
   // allocated and freed every frame. Mapped and unmapped each time (glibc's default for
   // large blocks), every page is faulted in again: measured, a third of the wall time of a

@@ -120,6 +120,7 @@ void WriteStats(const std::string& path, const RunSummary& s) {
        {{"p50", s.latency_ms_p50}, {"p95", s.latency_ms_p95}, {"max", s.latency_ms_max}}},
       {"map_points", s.map_points},
       {"peak_rss_mb", s.peak_rss_mb},
+      {"heap_huge_pages", s.heap_huge_pages},
       {"photometric_correction", s.photometric},
       {"end_of_input_events", s.end_events}};
   nlohmann::json all = j;

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -19,6 +20,7 @@
 #include "tools/dataset/input_error.hpp"
 #include "tools/dataset/photometric_corrector.hpp"
 #include "tools/dataset/trajectory.hpp"
+#include "tools/huge_page_heap.hpp"
 #include "tools/run_outputs.hpp"
 
 namespace parallax {
@@ -91,6 +93,7 @@ void Summarise(const System& system, const Timings& timings,
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   summary->peak_rss_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;
+  summary->heap_huge_pages = HeapUsesHugePages(std::getenv("GLIBC_TUNABLES"));
 }
 
 }  // namespace

@@ -52,6 +52,7 @@ struct RunSummary {
   double tracking_ms_p50 = 0.0, tracking_ms_p95 = 0.0;
   double mapping_ms_p50 = 0.0, mapping_ms_p95 = 0.0;
   double peak_rss_mb = 0.0;
+  bool heap_huge_pages = false;  ///< glibc backed the heap with huge pages (huge_page_heap.hpp)
   std::size_t map_points = 0;
   int initialised_at_frame = -1;  ///< -1: never initialised
   int frames_unusable = 0;        ///< rejected by the frame-quality gate
