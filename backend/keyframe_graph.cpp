@@ -163,8 +163,8 @@ std::size_t KeyframeGraph::Bytes() const {
     const ImagePyramid& pyramid = kf->frame->Pyramid();
     for (int l = 0; l < pyramid.NumLevels(); ++l) {
       const PyramidLevel& level = pyramid.Level(l);
-      // intensity, dx, dy, grad_sq
-      bytes += static_cast<std::size_t>(level.Width() * level.Height()) * sizeof(float) * 4;
+      // intensity, dx, dy
+      bytes += static_cast<std::size_t>(level.Width() * level.Height()) * sizeof(float) * 3;
     }
     if (kf->reference) {
       for (int l = 0; l < kf->reference->NumLevels(); ++l) {

@@ -69,7 +69,7 @@ void System::BufferInitialFrame(const std::shared_ptr<const Frame>& frame, const
   std::size_t pyramid_bytes = 0;
   for (int l = 0; l < frame->NumLevels(); ++l) {
     pyramid_bytes += static_cast<std::size_t>(frame->Level(l).Width() * frame->Level(l).Height()) *
-                     4 * sizeof(float);  // intensity, dx, dy, grad_sq
+                     3 * sizeof(float);  // intensity, dx, dy
   }
   const auto by_bytes = static_cast<std::size_t>(options_.max_buffered_megabytes * 1e6 /
                                                  static_cast<double>(pyramid_bytes));

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "core/check.hpp"
 
@@ -36,10 +38,10 @@ void Downsample2x2(const Plane& fine, const Plane& coarse) {
 
 void ZeroRow(const Plane& plane, int y) { std::fill_n(plane.Row(y), plane.width, 0.0f); }
 
-void ComputeGradients(const Plane& I, const Plane& dx, const Plane& dy, const Plane& g2) {
+void ComputeGradients(const Plane& I, const Plane& dx, const Plane& dy) {
   const int w = I.width;
   const int h = I.height;
-  for (const Plane* p : {&dx, &dy, &g2}) {
+  for (const Plane* p : {&dx, &dy}) {
     ZeroRow(*p, 0);
     ZeroRow(*p, h - 1);
   }
@@ -49,24 +51,20 @@ void ComputeGradients(const Plane& I, const Plane& dx, const Plane& dy, const Pl
     const float* __restrict down = I.Row(y + 1);
     float* __restrict gx_row = dx.Row(y);
     float* __restrict gy_row = dy.Row(y);
-    float* __restrict g2_row = g2.Row(y);
-    gx_row[0] = gy_row[0] = g2_row[0] = 0.0f;
-    gx_row[w - 1] = gy_row[w - 1] = g2_row[w - 1] = 0.0f;
+    gx_row[0] = gy_row[0] = 0.0f;
+    gx_row[w - 1] = gy_row[w - 1] = 0.0f;
     for (int x = 1; x < w - 1; ++x) {
-      const float gx = 0.5f * (mid[x + 1] - mid[x - 1]);
-      const float gy = 0.5f * (down[x] - up[x]);
-      gx_row[x] = gx;
-      gy_row[x] = gy;
-      g2_row[x] = gx * gx + gy * gy;
+      gx_row[x] = 0.5f * (mid[x + 1] - mid[x - 1]);
+      gy_row[x] = 0.5f * (down[x] - up[x]);
     }
   }
 }
 
 // No texture where no input is: the border of the valid area is not an edge.
-void ZeroInvalid(const ImageU8& valid, const Plane& dx, const Plane& dy, const Plane& g2) {
+void ZeroInvalid(const ImageU8& valid, const Plane& dx, const Plane& dy) {
   const std::size_t n = valid.NumPixels();
   for (std::size_t i = 0; i < n; ++i) {
-    if (valid.Data()[i] == 0) dx.data[i] = dy.data[i] = g2.data[i] = 0.0f;
+    if (valid.Data()[i] == 0) dx.data[i] = dy.data[i] = 0.0f;
   }
 }
 
@@ -96,7 +94,7 @@ ImagePyramid::ImagePyramid(const ImageView<std::uint8_t>& image, const PyramidOp
                                         validity->Level(0).Height() == image.Height()),
                 "ImagePyramid: the validity mask's size differs from the image's");
   const int num_levels = NumPyramidLevels(image.Width(), image.Height(), options);
-  constexpr std::size_t kPlanes = 4;  // intensity, dx, dy, grad_sq
+  constexpr std::size_t kPlanes = 3;  // intensity, dx, dy
   std::vector<std::size_t> offsets;
   std::size_t total = 0;
   for (int l = 0; l < num_levels; ++l) {
@@ -120,12 +118,12 @@ ImagePyramid::ImagePyramid(const ImageView<std::uint8_t>& image, const PyramidOp
   const bool masked = validity != nullptr && !validity->AllValid();
   for (std::size_t l = 0; l < planes.size(); ++l) {
     const auto& level = planes[l];
-    ComputeGradients(level[0], level[1], level[2], level[3]);
+    ComputeGradients(level[0], level[1], level[2]);
     const auto view = [](const Plane& p) { return ImageViewF(p.data, p.width, p.height); };
-    levels_.push_back(PyramidLevel{view(level[0]), view(level[1]), view(level[2]), view(level[3])});
+    levels_.push_back(PyramidLevel{view(level[0]), view(level[1]), view(level[2])});
     if (masked && static_cast<int>(l) < validity->NumLevels()) {
       const ImageU8& valid = validity->Level(static_cast<int>(l));
-      ZeroInvalid(valid, level[1], level[2], level[3]);
+      ZeroInvalid(valid, level[1], level[2]);
       levels_.back().valid = valid.Data();
     }
   }
@@ -139,10 +137,32 @@ ImageF MaxGradient3x3(const PyramidLevel& level) {
   // (docs/benchmarks.md, "Where a depth update and a keyframe spend their time"). sqrt is
   // monotonic and correctly rounded: the root of the largest square is the largest magnitude.
   ImageF out(w, h);
+  // The squared gradients of rows y - 1, y and y + 1 (clamped), each computed once.
+  std::array<std::vector<float>, 3> squares;
+  for (auto& row : squares) row.resize(static_cast<std::size_t>(w));
+  const auto square_row = [&](int y, std::vector<float>* row) {
+    const float* gx = level.dx.Row(y);
+    const float* gy = level.dy.Row(y);
+    for (int x = 0; x < w; ++x) (*row)[static_cast<std::size_t>(x)] = gx[x] * gx[x] + gy[x] * gy[x];
+  };
+  square_row(0, &squares[1]);
+  if (h > 1) square_row(1, &squares[2]);
   for (int y = 0; y < h; ++y) {
-    const std::array<const float*, 3> rows = {level.grad_sq.Row(std::max(y - 1, 0)),
-                                              level.grad_sq.Row(y),
-                                              level.grad_sq.Row(std::min(y + 1, h - 1))};
+    // squares[0..2] hold rows y - 1, y, y + 1 (clamped to the image).
+    if (y == 0) {
+      squares[0] = squares[1];
+      if (h == 1) squares[2] = squares[1];
+    } else {
+      std::swap(squares[0], squares[1]);
+      std::swap(squares[1], squares[2]);
+      if (y + 1 < h) {
+        square_row(y + 1, &squares[2]);
+      } else {
+        squares[2] = squares[1];
+      }
+    }
+    const std::array<const float*, 3> rows = {squares[0].data(), squares[1].data(),
+                                              squares[2].data()};
     float* dst = out.Row(y);
     for (int x = 0; x < w; ++x) {
       const int left = std::max(x - 1, 0), right = std::min(x + 1, w - 1);

@@ -28,13 +28,18 @@ struct PyramidLevel {
   ImageViewF intensity;
   ImageViewF dx;
   ImageViewF dy;
-  ImageViewF grad_sq;  ///< dx^2 + dy^2
   /// ValidityMask::Level of this level (row-major, this level's size): 0 where the pixel or
-  /// its stencils see no input, and dx, dy, grad_sq are 0 there. nullptr: all pixels valid.
+  /// its stencils see no input, and dx, dy are 0 there. nullptr: all pixels valid.
   const std::uint8_t* valid = nullptr;
 
   int Width() const { return intensity.Width(); }
   int Height() const { return intensity.Height(); }
+  /// dx^2 + dy^2 at a pixel. Computed where it is asked for rather than stored: few pixels
+  /// need it, and a fourth plane was a quarter of every frame's pyramid.
+  float GradSq(int x, int y) const {
+    const float gx = dx(x, y), gy = dy(x, y);
+    return gx * gx + gy * gy;
+  }
 };
 
 /// Intensity pyramid of an 8-bit grey image. Level l+1 has size floor(w_l / 2) x

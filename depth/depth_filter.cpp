@@ -202,7 +202,7 @@ void DepthFilter::FuseObservation(InverseDepthMap* map, int x, int y, const Ster
     ++stats->diverged;
     return;
   }
-  const float g = std::sqrt(map->Keyframe().Level(0).grad_sq(x, y));
+  const float g = std::sqrt(map->Keyframe().Level(0).GradSq(x, y));
   map->validity[i] =
       std::min(map->validity[i] + options_.validity_gain, 5.0f + 250.0f * g / 255.0f);
   if (map->observations[i] < 65535) ++map->observations[i];

@@ -56,7 +56,7 @@ void ProjectRow(const InverseDepthMap& old_map, const InverseDepthMap& map, cons
     }
     const std::size_t j = map.Index(nx, ny);
     const float expected = gain * old_image.intensity(x, y) + offset;
-    const float tolerance = 20.0f + 0.7f * std::sqrt(new_image.grad_sq(nx, ny));
+    const float tolerance = 20.0f + 0.7f * std::sqrt(new_image.GradSq(nx, ny));
     if (!map.eligible[j] || std::abs(new_image.intensity(nx, ny) - expected) > tolerance) {
       ++st->rejected;
       continue;

@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 
@@ -58,7 +59,11 @@ void RestartWithHugePageHeap(char** argv) {
   const std::string before = tunables != nullptr ? tunables : "";
   const bool was_set = tunables != nullptr;
   if (setenv("GLIBC_TUNABLES", TunablesWithHugePages(tunables).c_str(), 1) != 0) return;
-  execv("/proc/self/exe", argv);
+  // The resolved path, not /proc/self/exe, so that the process keeps its name ("exe"
+  // otherwise, in ps, top and perf).
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  execv(error ? "/proc/self/exe" : self.c_str(), argv);
   // Not executed again (no /proc, say): go on with the heap as it is, environment restored.
   if (was_set) {
     setenv("GLIBC_TUNABLES", before.c_str(), 1);

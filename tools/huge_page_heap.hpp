@@ -27,9 +27,9 @@ std::string TunablesWithHugePages(const char* tunables);
 /// Whether a GLIBC_TUNABLES value (nullptr when unset) asks glibc for a huge-page heap.
 bool HeapUsesHugePages(const char* tunables);
 
-/// Executes /proc/self/exe with `argv` and the tunable set when `DecideHugePageRestart`
-/// says so; returns (the process goes on as it is) otherwise or when that fails. Call it
-/// first in main, before any thread or allocation that should use the new heap.
+/// Executes this program (/proc/self/exe) again with `argv` and the tunable set when
+/// `DecideHugePageRestart` says so; returns (the process goes on as it is) otherwise or when that
+/// fails. Call it first in main, before any thread or allocation that should use the new heap.
 void RestartWithHugePageHeap(char** argv);
 
 }  // namespace parallax

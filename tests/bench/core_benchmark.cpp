@@ -26,7 +26,7 @@ void BM_PyramidWithGradients(benchmark::State& state) {
       RandomImage(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   for (auto _ : state) {
     ImagePyramid pyramid(image, PyramidOptions{});
-    benchmark::DoNotOptimize(pyramid.Level(pyramid.NumLevels() - 1).grad_sq.Data());
+    benchmark::DoNotOptimize(pyramid.Level(pyramid.NumLevels() - 1).dy.Data());
   }
 }
 BENCHMARK(BM_PyramidWithGradients)

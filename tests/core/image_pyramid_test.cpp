@@ -67,7 +67,7 @@ TEST(ImagePyramid, GradientsOfRampScaleWithLevel) {
     const double s = std::ldexp(1.0, l);  // one level-l pixel spans s level-0 pixels
     EXPECT_NEAR(level.dx(2, 3), a * s, 1e-5);
     EXPECT_NEAR(level.dy(2, 3), b * s, 1e-5);
-    EXPECT_NEAR(level.grad_sq(2, 3), (a * a + b * b) * s * s, 1e-5);
+    EXPECT_NEAR(level.GradSq(2, 3), (a * a + b * b) * s * s, 1e-5);
     EXPECT_EQ(level.dx(0, 3), 0.0f);  // border convention
     EXPECT_EQ(level.dy(2, level.Height() - 1), 0.0f);
   }
@@ -81,7 +81,7 @@ TEST(ImagePyramid, CheckerboardAveragesToGreyAtCellScale) {
   EXPECT_FLOAT_EQ(l2.intensity(1, 0), 200.0f);
   // Level 3 pixels cover 2x2 cells: the mean, 125.
   EXPECT_FLOAT_EQ(pyramid.Level(3).intensity(3, 3), 125.0f);
-  EXPECT_FLOAT_EQ(pyramid.Level(3).grad_sq(3, 3), 0.0f);
+  EXPECT_FLOAT_EQ(pyramid.Level(3).GradSq(3, 3), 0.0f);
 }
 
 TEST(ImagePyramid, RejectsEmptyImageAndBadOptions) {
@@ -129,7 +129,7 @@ TEST(SemiDenseSelection, MaxGradientIsMaximumOverNeighbourhood) {
       float expected = 0.0f;
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
-          expected = std::max(expected, std::sqrt(level.grad_sq(x + dx, y + dy)));
+          expected = std::max(expected, std::sqrt(level.GradSq(x + dx, y + dy)));
         }
       }
       EXPECT_FLOAT_EQ(max_grad(x, y), expected);
@@ -156,7 +156,7 @@ TEST(SemiDenseSelection, MaxGradientIsExactlyTheLargestMagnitudeInTheClampedWind
       float expected = 0.0f;
       for (int v = std::max(y - 1, 0); v <= std::min(y + 1, 22); ++v) {
         for (int u = std::max(x - 1, 0); u <= std::min(x + 1, 36); ++u) {
-          expected = std::max(expected, std::sqrt(level.grad_sq(u, v)));
+          expected = std::max(expected, std::sqrt(level.GradSq(u, v)));
         }
       }
       ASSERT_EQ(max_grad(x, y), expected) << x << ", " << y;

@@ -73,9 +73,10 @@ TEST(ValidityMask, ThePyramidHasNoGradientWhereNoInputIs) {
   for (int l = 0; l < masked.NumLevels(); ++l) {
     const PyramidLevel& level = masked.Level(l);
     ASSERT_EQ(level.valid, mask.Level(l).Data());
-    for (std::size_t i = 0; i < level.grad_sq.NumPixels(); ++i) {
+    for (std::size_t i = 0; i < level.dx.NumPixels(); ++i) {
       if (level.valid[i] == 0) {
-        EXPECT_EQ(level.grad_sq.Data()[i], 0.0f);
+        EXPECT_EQ(level.dx.Data()[i], 0.0f);
+        EXPECT_EQ(level.dy.Data()[i], 0.0f);
       }
     }
   }

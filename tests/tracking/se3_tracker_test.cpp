@@ -22,7 +22,7 @@ using test::RenderedKeyframe;
 // I = c + ax x + ay y + q ((x - 300)^2 + (y - 200)^2). Central differences of a quadratic
 // are exact at pixel centres and bilinear interpolation of the (linear) gradient is exact.
 struct AnalyticLevel {
-  ImageF intensity{640, 480}, dx{640, 480}, dy{640, 480}, grad_sq{640, 480};
+  ImageF intensity{640, 480}, dx{640, 480}, dy{640, 480};
   PyramidLevel level;
   explicit AnalyticLevel(double q) {
     for (int y = 0; y < 480; ++y) {
@@ -31,10 +31,9 @@ struct AnalyticLevel {
         intensity(x, y) = static_cast<float>(20.0 + 0.3 * x + 0.2 * y + q * (ex * ex + ey * ey));
         dx(x, y) = static_cast<float>(0.3 + 2.0 * q * ex);
         dy(x, y) = static_cast<float>(0.2 + 2.0 * q * ey);
-        grad_sq(x, y) = dx(x, y) * dx(x, y) + dy(x, y) * dy(x, y);
       }
     }
-    level = PyramidLevel{intensity, dx, dy, grad_sq};
+    level = PyramidLevel{intensity, dx, dy};
   }
 };
 
