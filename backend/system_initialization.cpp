@@ -68,8 +68,9 @@ void System::BufferInitialFrame(const std::shared_ptr<const Frame>& frame, const
   // (a few MB each); the oldest keep the pose they were given, or stay without one.
   std::size_t pyramid_bytes = 0;
   for (int l = 0; l < frame->NumLevels(); ++l) {
-    pyramid_bytes += static_cast<std::size_t>(frame->Level(l).Width() * frame->Level(l).Height()) *
-                     3 * sizeof(float);  // intensity, dx, dy
+    // intensity, dx, dy (level 0's gradients are computed if the frame becomes a keyframe)
+    const PyramidLevel& level = frame->IntensityLevel(l);
+    pyramid_bytes += static_cast<std::size_t>(level.Width() * level.Height()) * 3 * sizeof(float);
   }
   const auto by_bytes = static_cast<std::size_t>(options_.max_buffered_megabytes * 1e6 /
                                                  static_cast<double>(pyramid_bytes));

@@ -24,12 +24,19 @@ Frame::Frame(std::int64_t id, double timestamp, const PinholeCamera& camera, con
     : id_(id),
       timestamp_(timestamp),
       validity_(camera.Validity()),
-      pyramid_(CheckedImage(image, camera), pyramid_options, validity_.get()) {
+      pyramid_(CheckedImage(image, camera), pyramid_options, validity_.get(),
+               LevelZeroGradients::kDeferred) {
   CheckArgument(std::isfinite(timestamp), "Frame: timestamp must be finite");
   cameras_.reserve(static_cast<std::size_t>(pyramid_.NumLevels()));
   for (int level = 0; level < pyramid_.NumLevels(); ++level) {
     cameras_.push_back(camera.AtLevel(level));
   }
+}
+
+const PyramidLevel& Frame::LevelZero() const {
+  std::call_once(level_zero_once_,
+                 [this] { level_zero_ = pyramid_.LevelZeroWithGradients(&level_zero_gradients_); });
+  return level_zero_;
 }
 
 const ImageF& Frame::MaxGradient() const {

@@ -19,6 +19,8 @@ struct Plane {
   float* Row(int y) const { return data + static_cast<std::ptrdiff_t>(y) * width; }
 };
 
+ImageViewF View(const Plane& p) { return ImageViewF(p.data, p.width, p.height); }
+
 void ConvertToFloat(const ImageView<std::uint8_t>& image, const Plane& out) {
   const std::uint8_t* src = image.Data();
   const std::size_t n = image.NumPixels();
@@ -38,9 +40,9 @@ void Downsample2x2(const Plane& fine, const Plane& coarse) {
 
 void ZeroRow(const Plane& plane, int y) { std::fill_n(plane.Row(y), plane.width, 0.0f); }
 
-void ComputeGradients(const Plane& I, const Plane& dx, const Plane& dy) {
-  const int w = I.width;
-  const int h = I.height;
+void ComputeGradients(const ImageViewF& I, const Plane& dx, const Plane& dy) {
+  const int w = I.Width();
+  const int h = I.Height();
   for (const Plane* p : {&dx, &dy}) {
     ZeroRow(*p, 0);
     ZeroRow(*p, h - 1);
@@ -61,10 +63,10 @@ void ComputeGradients(const Plane& I, const Plane& dx, const Plane& dy) {
 }
 
 // No texture where no input is: the border of the valid area is not an edge.
-void ZeroInvalid(const ImageU8& valid, const Plane& dx, const Plane& dy) {
-  const std::size_t n = valid.NumPixels();
+void ZeroInvalid(const std::uint8_t* valid, const Plane& dx, const Plane& dy) {
+  const std::size_t n = static_cast<std::size_t>(dx.width) * static_cast<std::size_t>(dx.height);
   for (std::size_t i = 0; i < n; ++i) {
-    if (valid.Data()[i] == 0) dx.data[i] = dy.data[i] = 0.0f;
+    if (valid[i] == 0) dx.data[i] = dy.data[i] = 0.0f;
   }
 }
 
@@ -88,18 +90,20 @@ int NumPyramidLevels(int width, int height, const PyramidOptions& options) {
 }
 
 ImagePyramid::ImagePyramid(const ImageView<std::uint8_t>& image, const PyramidOptions& options,
-                           const ValidityMask* validity) {
+                           const ValidityMask* validity, LevelZeroGradients level_zero) {
   CheckArgument(!image.Empty(), "ImagePyramid: the input image is empty");
   CheckArgument(validity == nullptr || (validity->Level(0).Width() == image.Width() &&
                                         validity->Level(0).Height() == image.Height()),
                 "ImagePyramid: the validity mask's size differs from the image's");
   const int num_levels = NumPyramidLevels(image.Width(), image.Height(), options);
   constexpr std::size_t kPlanes = 3;  // intensity, dx, dy
+  const bool deferred = level_zero == LevelZeroGradients::kDeferred;
+  const auto planes_of = [&](std::size_t l) { return deferred && l == 0 ? 1 : kPlanes; };
   std::vector<std::size_t> offsets;
   std::size_t total = 0;
   for (int l = 0; l < num_levels; ++l) {
     offsets.push_back(total);
-    total += kPlanes * static_cast<std::size_t>(image.Width() >> l) *
+    total += planes_of(static_cast<std::size_t>(l)) * static_cast<std::size_t>(image.Width() >> l) *
              static_cast<std::size_t>(image.Height() >> l);
   }
   // Every element is written below, so a recycled buffer needs no clearing.
@@ -109,7 +113,7 @@ ImagePyramid::ImagePyramid(const ImageView<std::uint8_t>& image, const PyramidOp
     const int w = image.Width() >> l;
     const int h = image.Height() >> l;
     const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-    for (std::size_t p = 0; p < kPlanes; ++p)
+    for (std::size_t p = 0; p < planes_of(l); ++p)
       planes[l][p] = Plane{buffer_.get() + offsets[l] + p * n, w, h};
   }
   ConvertToFloat(image, planes[0][0]);
@@ -118,15 +122,28 @@ ImagePyramid::ImagePyramid(const ImageView<std::uint8_t>& image, const PyramidOp
   const bool masked = validity != nullptr && !validity->AllValid();
   for (std::size_t l = 0; l < planes.size(); ++l) {
     const auto& level = planes[l];
-    ComputeGradients(level[0], level[1], level[2]);
-    const auto view = [](const Plane& p) { return ImageViewF(p.data, p.width, p.height); };
-    levels_.push_back(PyramidLevel{view(level[0]), view(level[1]), view(level[2])});
-    if (masked && static_cast<int>(l) < validity->NumLevels()) {
-      const ImageU8& valid = validity->Level(static_cast<int>(l));
-      ZeroInvalid(valid, level[1], level[2]);
-      levels_.back().valid = valid.Data();
+    const std::uint8_t* valid = masked && static_cast<int>(l) < validity->NumLevels()
+                                    ? validity->Level(static_cast<int>(l)).Data()
+                                    : nullptr;
+    if (planes_of(l) == 1) {
+      levels_.push_back(PyramidLevel{View(level[0]), {}, {}, valid});
+      continue;
     }
+    ComputeGradients(View(level[0]), level[1], level[2]);
+    if (valid != nullptr) ZeroInvalid(valid, level[1], level[2]);
+    levels_.push_back(PyramidLevel{View(level[0]), View(level[1]), View(level[2]), valid});
   }
+}
+
+PyramidLevel ImagePyramid::LevelZeroWithGradients(FloatBufferPool::Buffer* storage) const {
+  const PyramidLevel& zero = levels_.front();
+  const int w = zero.Width(), h = zero.Height();
+  const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  *storage = FloatBufferPool::Shared().Take(2 * n);
+  const Plane dx{storage->get(), w, h}, dy{storage->get() + n, w, h};
+  ComputeGradients(zero.intensity, dx, dy);
+  if (zero.valid != nullptr) ZeroInvalid(zero.valid, dx, dy);
+  return PyramidLevel{zero.intensity, View(dx), View(dy), zero.valid};
 }
 
 ImageF MaxGradient3x3(const PyramidLevel& level) {

@@ -42,6 +42,12 @@ struct PyramidLevel {
   }
 };
 
+/// Whether an ImagePyramid computes level 0's gradients when it is built.
+enum class LevelZeroGradients {
+  kComputed,
+  kDeferred,  ///< level 0 has intensity only (dx, dy empty): LevelZeroWithGradients
+};
+
 /// Intensity pyramid of an 8-bit grey image. Level l+1 has size floor(w_l / 2) x
 /// floor(h_l / 2); each of its pixels is the mean of a 2x2 block of level l. With an odd size
 /// the last column (row) of level l has no parent and is dropped, so pixel centres keep the
@@ -54,7 +60,8 @@ class ImagePyramid {
   /// Throws std::invalid_argument for an empty image, invalid options or a `validity` whose
   /// level 0 is not the image's size. `validity` (may be null) must outlive the pyramid.
   explicit ImagePyramid(const ImageView<std::uint8_t>& image, const PyramidOptions& options = {},
-                        const ValidityMask* validity = nullptr);
+                        const ValidityMask* validity = nullptr,
+                        LevelZeroGradients level_zero = LevelZeroGradients::kComputed);
   ImagePyramid(const ImagePyramid&) = delete;
   ImagePyramid& operator=(const ImagePyramid&) = delete;
   ImagePyramid(ImagePyramid&&) noexcept = default;
@@ -64,6 +71,9 @@ class ImagePyramid {
   int NumLevels() const { return static_cast<int>(levels_.size()); }
   /// Precondition: 0 <= level < NumLevels().
   const PyramidLevel& Level(int level) const { return levels_[static_cast<std::size_t>(level)]; }
+  /// Level 0 with its gradients, computed into `storage` (taken from the shared pool), as
+  /// the constructor computes them: for a pyramid built with LevelZeroGradients::kDeferred.
+  PyramidLevel LevelZeroWithGradients(FloatBufferPool::Buffer* storage) const;
 
  private:
   FloatBufferPool::Buffer buffer_;  ///< from FloatBufferPool::Shared()

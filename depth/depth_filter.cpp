@@ -211,8 +211,8 @@ void DepthFilter::FuseObservation(InverseDepthMap* map, int x, int y, const Ster
 
 DepthUpdateStats DepthFilter::Update(InverseDepthMap* map, const StereoFrame& frame) const {
   CheckArgument(frame.frame != nullptr, "DepthFilter::Update: no frame");
-  CheckArgument(frame.frame->Level(0).Width() == map->Width() &&
-                    frame.frame->Level(0).Height() == map->Height(),
+  CheckArgument(frame.frame->IntensityLevel(0).Width() == map->Width() &&
+                    frame.frame->IntensityLevel(0).Height() == map->Height(),
                 "DepthFilter::Update: frame and keyframe sizes differ");
   const EpipolarSearch search(map->Keyframe(), frame, options_);
   const int w = map->Width();

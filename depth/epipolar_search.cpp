@@ -104,7 +104,7 @@ EpipolarSearch::LineGeometry EpipolarSearch::MakeLineGeometry(const PinholeCamer
 EpipolarSearch::EpipolarSearch(const Frame& keyframe, const StereoFrame& frame,
                                const DepthFilterOptions& options)
     : kf_(keyframe.Level(0)),
-      frame_(frame.frame->Level(0)),
+      frame_(frame.frame->IntensityLevel(0)),
       fx_(static_cast<float>(keyframe.Camera(0).Fx())),
       fy_(static_cast<float>(keyframe.Camera(0).Fy())),
       cx_(static_cast<float>(keyframe.Camera(0).Cx())),
