@@ -268,6 +268,8 @@ class System {
                                    const TwoViewPair& pair);
   FrameResult ProcessTwoViewOnly(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
   /// Abandons the start (its poses withdrawn) and starts again on `frame`.
+  /// Ends the search for a two-view pair: the bootstrap and any fallback pair are dropped.
+  void EndPairSearch();
   FrameResult RestartStart(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
   std::optional<FrameResult> ProcessWhileInitialising(const std::shared_ptr<const Frame>& frame,
                                                       const ImageU8& image,
@@ -361,6 +363,9 @@ class System {
   /// Auto: the first good pair, held until the random start has converged (or failed) and
   /// either agrees with it or is replaced by it.
   std::optional<std::pair<std::shared_ptr<const Frame>, TwoViewPair>> pending_pair_;
+  /// Auto, while no pair is good enough: the pair with the most parallax among those that
+  /// failed only on parallax (min_fallback_parallax_deg), taken if the random start is lost.
+  std::optional<std::pair<std::shared_ptr<const Frame>, TwoViewPair>> fallback_pair_;
   /// Locks: engine_mutex_ (everything the mapping stages touch) before poses_mutex_
   /// (frame_poses_, frame_timestamps_, pending_events_); the live tracker's own state is
   /// the caller's. In the deterministic mode they are uncontended.

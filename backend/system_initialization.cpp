@@ -52,7 +52,7 @@ void System::StartRandom(const std::shared_ptr<const Frame>& frame, const ImageU
   StartKeyframe(frame, Sim3d(), std::move(map), result);
   depth_updates_ = 0;
   lost_in_a_row_ = 0;
-  bootstrap_.reset();
+  EndPairSearch();
   start_ = StartState::kConverging;
   if (options_.initialization == Initialization::kAuto) {
     bootstrap_ = std::make_unique<TwoViewBootstrap>(camera_, options_.bootstrap);
@@ -141,7 +141,7 @@ std::vector<RevisedPose> System::FinishInitialisation() {
     }
   }
   initial_frames_.clear();
-  bootstrap_.reset();
+  EndPairSearch();
   start_ = StartState::kInitialised;
   ++map_generation_;
   if (initialised_at_frame_ < 0) {  // the first map's
@@ -183,13 +183,17 @@ std::optional<FrameResult> System::ProcessWhileInitialising(
     return RestartStart(frame, image);
   }
   if (start_ == StartState::kRandomPairSearch) {
-    if (const auto pair = bootstrap_->TryFrame(image)) {
+    std::optional<TwoViewPair> fallback;
+    if (const auto pair = bootstrap_->TryFrame(image, &fallback)) {
       pending_pair_.emplace(frame, *pair);
-      bootstrap_.reset();
+      EndPairSearch();
       start_ = StartState::kRandomPairHeld;
     } else if (++bootstrap_tries_ >= options_.bootstrap_max_frames) {
-      bootstrap_.reset();
+      EndPairSearch();
       start_ = StartState::kConverging;
+    } else if (fallback &&
+               (!fallback_pair_ || fallback->parallax_deg > fallback_pair_->second.parallax_deg)) {
+      fallback_pair_.emplace(frame, *fallback);
     }
   }
   if (tracked.status == TrackingStatus::kOk) {
@@ -207,6 +211,16 @@ std::optional<FrameResult> System::ProcessWhileInitialising(
     return result;
   }
   if (tracked.status == TrackingStatus::kPoor) return std::nullopt;
+  if (start_ == StartState::kRandomPairSearch && fallback_pair_) {
+    // The random start is lost before any pair had enough parallax (forward motion: the
+    // parallax can peak below the bound and fall again): the best pair so far beats waiting
+    // for a restart that withdraws every pose (docs/configuration.md).
+    const auto [pair_frame, pair] = *fallback_pair_;
+    BufferInitialFrame(frame, tracker_.State().T_kf_last);
+    result.revised = StartFromPair(pair_frame, pair);
+    TakeNewestRevision(&result);
+    return result;
+  }
   result.status = TrackingStatus::kLost;
   // Lost frames wait (a pair may still be found for them); after restart_after_lost in a row
   // a restart is the way out, also while a pair is sought: a start on a bad first frame
@@ -218,6 +232,11 @@ std::optional<FrameResult> System::ProcessWhileInitialising(
   return RestartStart(frame, image);
 }
 
+void System::EndPairSearch() {
+  bootstrap_.reset();
+  fallback_pair_.reset();
+}
+
 FrameResult System::RestartStart(const std::shared_ptr<const Frame>& frame, const ImageU8& image) {
   // The start has failed: withdraw every pose given so far and start again here.
   std::vector<RevisedPose> withdrawn;
@@ -226,7 +245,7 @@ FrameResult System::RestartStart(const std::shared_ptr<const Frame>& frame, cons
     withdrawn.push_back(Revised(*buffered.first, std::nullopt));
   }
   initial_frames_.clear();
-  bootstrap_.reset();
+  EndPairSearch();
   pending_pair_.reset();
   ClearMap();
   start_ = StartState::kNoKeyframe;
@@ -262,7 +281,7 @@ std::vector<RevisedPose> System::StartFromPair(const std::shared_ptr<const Frame
       &map, StereoFrame{pair_frame.get(), pair.T_frame_ref, pair.gain, pair.offset, 0.0f});
   const float s = mapper_.Filter().NormalizeScale(&map);
   mapper_.SetMap(std::move(map));
-  bootstrap_.reset();
+  EndPairSearch();
   start_ = StartState::kConverging;  // pending_pair_ is the caller's to drop
   depth_updates_ = 1;
   lost_in_a_row_ = 0;

@@ -107,7 +107,7 @@ FrameResult System::StartNewMap(const std::shared_ptr<const Frame>& frame, const
   depth_updates_ = 0;
   lost_in_a_row_ = 0;
   initial_frames_.clear();
-  bootstrap_.reset();
+  EndPairSearch();
   pending_pair_.reset();
   FrameResult result = StartFirstKeyframe(frame, image);
   SystemEvent started{SystemEvent::Kind::kNewMap, frame->Id(),

@@ -33,6 +33,8 @@ void TwoViewBootstrapOptions::Check() const {
               "must be in (0, 1)");
   CheckOption(min_inliers >= 8, "TwoViewBootstrapOptions", "min_inliers", "must be >= 8");
   CheckOption(min_parallax_deg > 0.0, "TwoViewBootstrapOptions", "min_parallax_deg", "must be > 0");
+  CheckOption(min_fallback_parallax_deg >= 0.0, "TwoViewBootstrapOptions",
+              "min_fallback_parallax_deg", "must be >= 0");
   CheckOption(parallax_points >= 1, "TwoViewBootstrapOptions", "parallax_points", "must be >= 1");
   CheckOption(max_homography_share > 0.0 && max_homography_share <= 1.0, "TwoViewBootstrapOptions",
               "max_homography_share", "must be in (0, 1]");
@@ -247,7 +249,8 @@ bool Determined(const PinholeCamera& camera, const TwoViewBootstrapOptions& opti
 
 }  // namespace
 
-std::optional<TwoViewPair> TwoViewBootstrap::TryFrame(const ImageU8& image) {
+std::optional<TwoViewPair> TwoViewBootstrap::TryFrame(const ImageU8& image,
+                                                      std::optional<TwoViewPair>* fallback) {
   const TwoViewBootstrapOptions& options = impl_->options;
   if (impl_->ref_keypoints.size() < 50) return std::nullopt;
   std::vector<cv::KeyPoint> keypoints;
@@ -275,7 +278,10 @@ std::optional<TwoViewPair> TwoViewBootstrap::TryFrame(const ImageU8& image) {
   if (static_cast<int>(tri.depths.size()) < options.min_inliers) return std::nullopt;
   TwoViewPair pair;
   pair.parallax_deg = KthLargest(tri.angles_deg, options.parallax_points);
-  if (pair.parallax_deg < options.min_parallax_deg) return std::nullopt;
+  const bool enough_parallax = pair.parallax_deg >= options.min_parallax_deg;
+  const bool offer_fallback = fallback != nullptr && options.min_fallback_parallax_deg > 0.0 &&
+                              pair.parallax_deg >= options.min_fallback_parallax_deg;
+  if (!enough_parallax && !offer_fallback) return std::nullopt;
   const PixelCorrespondences inliers = Inlying(matches, tri.match_index);
   const NormalisedInliers normalised = Normalise(impl_->camera, inliers);
   const RelativePose refined = PolishOnInliers(normalised, {SO3d(R_e), t_e.normalized()});
@@ -299,6 +305,10 @@ std::optional<TwoViewPair> TwoViewBootstrap::TryFrame(const ImageU8& image) {
     cur_means.push_back(PatchMean(image, matches.cur[i]));
   }
   FitBrightness(ref_means, cur_means, &pair);
+  if (!enough_parallax) {
+    *fallback = pair;
+    return std::nullopt;
+  }
   return pair;
 }
 

@@ -18,6 +18,11 @@ struct TwoViewBootstrapOptions {
   /// angle of `min_parallax_deg` or more (ORB-SLAM's rule; a median would wait forever on
   /// forward motion, where the points near the direction of travel never gain parallax).
   double min_parallax_deg = 2.0;
+  /// A pair that passes every gate but has only this much parallax (or more, but below
+  /// min_parallax_deg) is offered as a fallback (TryFrame's `fallback`): the start takes it when
+  /// its random depth is lost before any pair is good enough (forward motion, whose parallax can
+  /// peak below the bound and then fall as the near points leave the view). 0: no fallback.
+  double min_fallback_parallax_deg = 1.0;
   int parallax_points = 50;
   double ransac_threshold_px = 1.0;
   /// A pair is refused while a homography explains more than this share of its inliers
@@ -69,8 +74,11 @@ class TwoViewBootstrap {
   TwoViewBootstrap& operator=(TwoViewBootstrap&&) noexcept;
 
   void SetReference(const ImageU8& image);
-  /// The pair when it is good enough, else nullopt. Precondition: SetReference was called.
-  std::optional<TwoViewPair> TryFrame(const ImageU8& image);
+  /// The pair when it is good enough, else nullopt. When it fails only for parallax, but has
+  /// at least `min_fallback_parallax_deg`, and `fallback` is not null, the pair is written
+  /// there. Precondition: SetReference was called.
+  std::optional<TwoViewPair> TryFrame(const ImageU8& image,
+                                      std::optional<TwoViewPair>* fallback = nullptr);
 
  private:
   struct Impl;

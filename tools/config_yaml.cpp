@@ -81,6 +81,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"min_start_texture", Set(&o->min_start_texture)},
         {"bootstrap_max_frames", Set(&o->bootstrap_max_frames)},
         {"bootstrap_min_parallax_deg", Set(&o->bootstrap.min_parallax_deg)},
+        {"bootstrap_min_fallback_parallax_deg", Set(&o->bootstrap.min_fallback_parallax_deg)},
         {"bootstrap_parallax_points", Set(&o->bootstrap.parallax_points)},
         {"bootstrap_min_inliers", Set(&o->bootstrap.min_inliers)},
         {"bootstrap_max_homography_share", Set(&o->bootstrap.max_homography_share)},

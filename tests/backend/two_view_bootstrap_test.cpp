@@ -54,6 +54,46 @@ TEST_F(TwoViewBootstrapTest, RecoversRotationTranslationDirectionAndGain) {
   EXPECT_NEAR(pair->offset, 0.0, 8.0);
 }
 
+// A pair that fails only on parallax is offered as the start's fallback, equal to what a
+// lower bound would have accepted; none is offered below min_fallback_parallax_deg, or when
+// the caller does not ask.
+TEST_F(TwoViewBootstrapTest, APairShortOfParallaxIsOfferedAsAFallback) {
+  const SE3d T_ref_frame(SO3d::Exp(Eigen::Vector3d(0.0, 3.0 / kDegPerRad, 0.0)),
+                         Eigen::Vector3d(0.20, 0.0, 0.05));
+  const ImageU8 ref = RenderImage(T_w_ref_, 1.0f, 1.0);
+  const ImageU8 moved = RenderImage(Moved(T_ref_frame), 1.0f, 1.0);
+  TwoViewBootstrapOptions options;
+  options.max_offset_sigma = 0.0;
+  TwoViewBootstrap accepting(camera_, options);
+  accepting.SetReference(ref);
+  const auto pair = accepting.TryFrame(moved);
+  ASSERT_TRUE(pair.has_value());
+
+  options.min_parallax_deg = pair->parallax_deg + 1.0;
+  options.min_fallback_parallax_deg = pair->parallax_deg - 0.5;
+  TwoViewBootstrap strict(camera_, options);
+  strict.SetReference(ref);
+  std::optional<TwoViewPair> fallback;
+  EXPECT_FALSE(strict.TryFrame(moved, &fallback).has_value());
+  ASSERT_TRUE(fallback.has_value());
+  EXPECT_EQ(fallback->parallax_deg, pair->parallax_deg);
+  EXPECT_EQ(fallback->inliers, pair->inliers);
+  EXPECT_TRUE(fallback->T_frame_ref.Matrix().isApprox(pair->T_frame_ref.Matrix(), 1e-12));
+  EXPECT_FALSE(strict.TryFrame(moved).has_value());  // not asked for: nothing
+
+  options.min_fallback_parallax_deg = pair->parallax_deg + 0.5;  // too little for a fallback
+  TwoViewBootstrap stricter(camera_, options);
+  stricter.SetReference(ref);
+  std::optional<TwoViewPair> none;
+  EXPECT_FALSE(stricter.TryFrame(moved, &none).has_value());
+  EXPECT_FALSE(none.has_value());
+  options.min_fallback_parallax_deg = 0.0;  // off
+  TwoViewBootstrap off(camera_, options);
+  off.SetReference(ref);
+  EXPECT_FALSE(off.TryFrame(moved, &none).has_value());
+  EXPECT_FALSE(none.has_value());
+}
+
 TEST_F(TwoViewBootstrapTest, RejectsPairsWithoutParallax) {
   TwoViewBootstrap bootstrap(camera_);
   bootstrap.SetReference(RenderImage(T_w_ref_, 1.0f, 1.0));
