@@ -267,9 +267,9 @@ class System {
   BufferedPoses KeepTheBetterStart(const std::shared_ptr<const Frame>& pair_frame,
                                    const TwoViewPair& pair);
   FrameResult ProcessTwoViewOnly(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
-  /// Abandons the start (its poses withdrawn) and starts again on `frame`.
   /// Ends the search for a two-view pair: the bootstrap and any fallback pair are dropped.
   void EndPairSearch();
+  /// Abandons the start (its poses withdrawn) and starts again on `frame`.
   FrameResult RestartStart(const std::shared_ptr<const Frame>& frame, const ImageU8& image);
   std::optional<FrameResult> ProcessWhileInitialising(const std::shared_ptr<const Frame>& frame,
                                                       const ImageU8& image,

@@ -52,7 +52,9 @@ struct RunSummary {
   double tracking_ms_p50 = 0.0, tracking_ms_p95 = 0.0;
   double mapping_ms_p50 = 0.0, mapping_ms_p95 = 0.0;
   double peak_rss_mb = 0.0;
-  bool heap_huge_pages = false;  ///< glibc backed the heap with huge pages (huge_page_heap.hpp)
+  /// glibc was asked to back the heap with huge pages (huge_page_heap.hpp); the kernel gives
+  /// them where its transparent huge pages are not "never".
+  bool heap_huge_pages = false;
   std::size_t map_points = 0;
   int initialised_at_frame = -1;  ///< -1: never initialised
   int frames_unusable = 0;        ///< rejected by the frame-quality gate
