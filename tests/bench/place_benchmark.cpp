@@ -4,9 +4,12 @@
 
 #include <benchmark/benchmark.h>
 
+#include <cstring>
+#include <opencv2/features2d.hpp>
 #include <random>
 
 #include "backend/loop_closer.hpp"
+#include "backend/orb_matching.hpp"
 #include "backend/place_recognizer.hpp"
 #include "backend/sim3_ransac.hpp"
 #include "tests/backend/revisit_fixture.hpp"
@@ -27,6 +30,32 @@ void BM_OrbExtract640x480(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(ExtractOrb(image));
 }
 BENCHMARK(BM_OrbExtract640x480)->Unit(benchmark::kMillisecond);
+
+/// The two-view start's matching: 1,500 ORB features of one view against another's, the
+/// nearest two of each (arg 0: NearestTwoByHamming; 1: OpenCV's BFMatcher::knnMatch, which it
+/// replaced with the same result).
+void BM_StartMatching(benchmark::State& state) {
+  const OrbOptions options{.max_features = 1500};
+  const OrbFeatures a = ExtractOrb(View(0.10), options), b = ExtractOrb(View(0.12), options);
+  const auto rows = [](const std::vector<OrbDescriptor>& d) {
+    cv::Mat m(static_cast<int>(d.size()), 32, CV_8U);
+    for (std::size_t i = 0; i < d.size(); ++i)
+      std::memcpy(m.ptr(static_cast<int>(i)), d[i].data(), sizeof(OrbDescriptor));
+    return m;
+  };
+  const cv::Mat rows_a = rows(a.descriptors), rows_b = rows(b.descriptors);
+  std::vector<std::vector<cv::DMatch>> knn;
+  for (auto _ : state) {
+    if (state.range(0) == 0) {
+      benchmark::DoNotOptimize(NearestTwoByHamming(a.descriptors, b.descriptors));
+    } else {
+      cv::BFMatcher(cv::NORM_HAMMING).knnMatch(rows_a, rows_b, knn, 2);
+      benchmark::DoNotOptimize(knn.data());
+    }
+  }
+  state.counters["features"] = static_cast<double>(a.Size());
+}
+BENCHMARK(BM_StartMatching)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 void BM_VocabularyTransformPerKeyframe(benchmark::State& state) {
   const OrbFeatures features = ExtractOrb(View(0.1));
