@@ -412,13 +412,19 @@ TEST(Pipeline, PureRotationKeepsThePositionAndTheMap) {
   EXPECT_LE(system.Keyframes().size(), 8u);  // no keyframe per rotated frame
 }
 
+/// A run of one of ../shared/data's clips with its outputs in `dir`.
+RunOptions SharedClipRun(const std::string& clip, const test::TempDirAt& dir) {
+  RunOptions run;
+  run.dataset = test::SharedDataDir() + "/" + clip;
+  run.out_dir = dir.File("out");
+  return run;
+}
+
 TEST(Pipeline, SharedTumClip) {
   if (test::SharedDataDir().empty())
     GTEST_SKIP() << "../shared/data is absent; TUM end-to-end test skipped";
   const test::TempDirAt dir("parallax_pipeline_tum");
-  RunOptions run;
-  run.dataset = test::SharedDataDir() + "/rgbd_dataset_freiburg1_xyz_first37";
-  run.out_dir = dir.File("out");
+  const RunOptions run = SharedClipRun("rgbd_dataset_freiburg1_xyz_first37", dir);
   const RunSummary s = RunDataset(run);
   const EvaluationReport r = Evaluate(ReadTumTrajectory(run.out_dir + "/trajectory.txt"),
                                       ReadTumTrajectory(run.dataset + "/groundtruth.txt"), {});
@@ -444,11 +450,9 @@ TEST(Pipeline, AForwardStartShortOfParallaxStartsFromItsBestPair) {
   if (test::SharedDataDir().empty())
     GTEST_SKIP() << "../shared/data is absent; KITTI start test skipped";
   const test::TempDirAt dir("parallax_pipeline_kitti_start");
-  RunOptions run;
-  run.dataset = test::SharedDataDir() + "/kitti_odometry_07_first160";
+  RunOptions run = SharedClipRun("kitti_odometry_07_first160", dir);
   run.first_frame = 1;
   run.max_frames = 60;
-  run.out_dir = dir.File("out");
   const RunSummary s = RunDataset(run);
   EXPECT_EQ(s.frames_tracked, 60);
   EXPECT_GE(s.initialised_at_frame, 0);
