@@ -23,10 +23,16 @@ struct DecodeResult {
   std::string message;  ///< why, when not kOk
 };
 
+/// Which decoders DecodePng may use.
+enum class PngDecoders {
+  kDirectFirst,  ///< the direct decoder for the PNGs it handles (png_direct.hpp), else libpng
+  kLibpngOnly,   ///< libpng for every file (tests and benchmarks compare the two)
+};
+
 /// Decodes a PNG file. With `size_only` set, reads the header only: the size goes there and
 /// `pixels` stays empty.
 DecodeResult DecodePng(const std::string& path, ImageReadMode mode, long long max_pixels,
-                       cv::Size* size_only);
+                       cv::Size* size_only, PngDecoders decoders = PngDecoders::kDirectFirst);
 
 /// Decodes a JPEG file; kNotHandled for CMYK, an Exif block (OpenCV rotates by its
 /// orientation) and Motion-JPEG frames without Huffman tables.

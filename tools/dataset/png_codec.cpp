@@ -11,8 +11,10 @@
 #include <csetjmp>
 #include <cstdio>
 #include <cstring>
+#include <vector>
 
 #include "tools/dataset/image_codecs.hpp"
+#include "tools/dataset/png_direct.hpp"
 
 namespace parallax::codecs {
 namespace {
@@ -128,6 +130,24 @@ bool ReadRows(PngSession* s, const PngHeader* h, int channels, bool eight_bit, p
   return true;
 }
 
+/// The file's bytes in a buffer reused by the thread (empty when it cannot be read: libpng
+/// then reports why).
+const std::vector<std::uint8_t>& ReadWholeFile(const std::string& path) {
+  thread_local std::vector<std::uint8_t> bytes;
+  bytes.clear();
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) return bytes;
+  if (std::fseek(file, 0, SEEK_END) == 0) {
+    const long size = std::ftell(file);
+    if (size > 0 && std::fseek(file, 0, SEEK_SET) == 0) {
+      bytes.resize(static_cast<std::size_t>(size));
+      bytes.resize(std::fread(bytes.data(), 1, bytes.size(), file));
+    }
+  }
+  std::fclose(file);
+  return bytes;
+}
+
 bool WriteRows(PngSession* s, const cv::Mat* image, int level) {
   if (setjmp(png_jmpbuf(s->png)) != 0) return false;
   png_init_io(s->png, s->file);
@@ -148,8 +168,18 @@ bool WriteRows(PngSession* s, const cv::Mat* image, int level) {
 }  // namespace
 
 DecodeResult DecodePng(const std::string& path, ImageReadMode mode, long long max_pixels,
-                       cv::Size* size_only) {
+                       cv::Size* size_only, PngDecoders decoders) {
   DecodeResult result;
+  if (size_only == nullptr && mode == ImageReadMode::kGrey8 &&
+      decoders == PngDecoders::kDirectFirst) {
+    // A sequence's frames: the direct decoder, when the file is one it handles.
+    const std::vector<std::uint8_t>& bytes = ReadWholeFile(path);
+    if (auto grey = DecodeCommonPng(bytes.data(), bytes.size(), max_pixels)) {
+      result.status = DecodeStatus::kOk;
+      result.pixels = std::move(*grey);
+      return result;
+    }
+  }
   PngSession s;
   s.file = std::fopen(path.c_str(), "rb");
   if (s.file == nullptr) {
