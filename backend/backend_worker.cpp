@@ -6,13 +6,14 @@
 
 #include <utility>
 
+#include "backend/arena_width.hpp"
 #include "core/check.hpp"
 #include "core/thread_name.hpp"
 
 namespace parallax {
 
-BackendWorker::BackendWorker(std::function<void()> run, int threads, int nice)
-    : run_(std::move(run)), arena_(threads) {
+BackendWorker::BackendWorker(std::function<void()> run, int threads, int drain_threads, int nice)
+    : run_(std::move(run)), arena_(ArenaWidth(threads)), drain_arena_(ArenaWidth(drain_threads)) {
   CheckArgument(static_cast<bool>(run_), "BackendWorker: no work function");
   thread_ = std::thread([this, nice] { Loop(nice); });
 }
@@ -34,9 +35,23 @@ void BackendWorker::Notify() {
 }
 
 void BackendWorker::Drain() {
+  ++drainers_;
   std::unique_lock<std::mutex> lock(mutex_);
   idle_.wait(lock, [this] { return (!requested_ && !busy_) || stopping_; });
+  --drainers_;
   RethrowFailure();
+}
+
+bool BackendWorker::Draining() const { return drainers_.load() > 0; }
+
+void BackendWorker::RunStep(const std::function<void()>& step) {
+  // The work that remains when the caller drains (the end of a sequence) has the cores to
+  // itself: tracking and mapping are done.
+  if (Draining()) {
+    drain_arena_.execute(step);
+  } else {
+    step();
+  }
 }
 
 bool BackendWorker::Stop() {

@@ -6,6 +6,7 @@
 
 #include <tbb/task_arena.h>
 
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <exception>
@@ -18,10 +19,12 @@ namespace parallax {
 class BackendWorker {
  public:
   /// `run` does the waiting work (all of it: requests made while it runs wake it again);
-  /// `threads`: TBB concurrency of its arena; `nice`: the thread's scheduling niceness
-  /// (Linux; 0 leaves it as the caller's, a positive value lets tracking and mapping go
-  /// first on a busy machine). The thread starts here.
-  BackendWorker(std::function<void()> run, int threads, int nice);
+  /// `threads`: TBB concurrency of its arena; `drain_threads`: that of the arena its steps
+  /// (RunStep) move to while a caller waits in Drain() (the caller is idle then; under
+  /// ThreadSanitizer 1, see ArenaWidth); `nice`: the thread's scheduling niceness (Linux; 0
+  /// leaves it as the caller's, a positive value lets tracking and mapping go first on a busy
+  /// machine). The thread starts here.
+  BackendWorker(std::function<void()> run, int threads, int drain_threads, int nice);
   /// Stop().
   ~BackendWorker();
   BackendWorker(const BackendWorker&) = delete;
@@ -36,6 +39,11 @@ class BackendWorker {
   bool Stop();
   /// Times `run` was called.
   std::int64_t Runs() const;
+  /// Whether a caller waits in Drain().
+  bool Draining() const;
+  /// For `run`, on the worker's thread: runs `step` (one keyframe's work), in the drain
+  /// arena when a caller waits in Drain(), else in the worker's own.
+  void RunStep(const std::function<void()>& step);
 
  private:
   void Loop(int nice);
@@ -43,6 +51,8 @@ class BackendWorker {
 
   std::function<void()> run_;
   tbb::task_arena arena_;
+  tbb::task_arena drain_arena_;
+  std::atomic<int> drainers_{0};  ///< callers waiting in Drain()
   mutable std::mutex mutex_;
   std::condition_variable wake_;  ///< work was requested, or stop
   std::condition_variable idle_;  ///< a run finished

@@ -2,24 +2,11 @@
 
 #include <algorithm>
 
+#include "backend/arena_width.hpp"
 #include "core/check.hpp"
 #include "core/thread_name.hpp"
 
 namespace parallax {
-
-namespace {
-
-#if defined(__SANITIZE_THREAD__)
-constexpr bool kThreadSanitizer = true;  // g++
-#elif defined(__has_feature)
-constexpr bool kThreadSanitizer = __has_feature(thread_sanitizer);  // clang
-#else
-constexpr bool kThreadSanitizer = false;
-#endif
-
-}  // namespace
-
-int MappingWorker::ArenaWidth(int threads) { return kThreadSanitizer ? 1 : threads; }
 
 MappingWorker::MappingWorker(Process process, std::size_t max_pending, int threads,
                              int waited_threads, int keyframe_threads)

@@ -98,11 +98,6 @@ class MappingWorker {
   /// Refinements skipped because mapping was behind.
   std::int64_t Skipped() const;
 
-  /// The TBB concurrency an arena asked for `threads` gets: `threads`, or 1 in a
-  /// ThreadSanitizer build (libtbb is not instrumented, so TSan cannot see the
-  /// synchronisation of TBB's worker threads and reports their parallel loops as races).
-  static int ArenaWidth(int threads);
-
  private:
   struct Entry {
     MappingJob job;

@@ -62,6 +62,9 @@ struct RealtimeOptions {
   /// shares them with tracking and mapping, which go first when it is positive.
   int backend_threads = 1;
   int backend_nice = 10;
+  /// TBB concurrency of the backend's remaining work while a caller waits for it
+  /// (FinishMapping at the end of a sequence, with tracking and mapping done).
+  int backend_drain_threads = 2;
   /// Until the map is usable (the start, a new map after a long loss, the first
   /// relocalisation on a loaded map) a frame is
   /// handed to the mapping thread and answered at once without a pose (initialising; its

@@ -33,6 +33,8 @@ void RealtimeOptions::Check() const {
   CheckOption(snapshot_keyframe_poses >= 0, "RealtimeOptions", "snapshot_keyframe_poses",
               "must be >= 0");
   CheckOption(backend_threads >= 1, "RealtimeOptions", "backend_threads", "must be >= 1");
+  CheckOption(backend_drain_threads >= 1, "RealtimeOptions", "backend_drain_threads",
+              "must be >= 1");
   CheckOption(backend_nice >= 0 && backend_nice <= 19, "RealtimeOptions", "backend_nice",
               "must be in [0, 19]");
   CheckOption(max_queued_start_frames >= 1, "RealtimeOptions", "max_queued_start_frames",
@@ -43,9 +45,9 @@ void RealtimeOptions::Check() const {
 void System::StartRealtime() {
   cv::setNumThreads(options_.realtime.opencv_threads);
   live_ = std::make_unique<LiveTracker>(options_.tracker, options_.realtime.tracking_threads);
-  backend_worker_ = std::make_unique<BackendWorker>([this] { RunBackendBatch(); },
-                                                    options_.realtime.backend_threads,
-                                                    options_.realtime.backend_nice);
+  backend_worker_ = std::make_unique<BackendWorker>(
+      [this] { RunBackendBatch(); }, options_.realtime.backend_threads,
+      options_.realtime.backend_drain_threads, options_.realtime.backend_nice);
   worker_ = std::make_unique<MappingWorker>(
       [this](const MappingJob& job) { return MapJob(job); },
       static_cast<std::size_t>(options_.realtime.max_pending_frames),
@@ -338,7 +340,7 @@ void System::RunBackendBatch() {
   BackendStats stats;
   std::vector<SystemEvent> events;
   for (const FinishedKeyframe& finished : backend_running_) {
-    RunBackendOn(&work, finished, frame_id, &stats, &events);
+    backend_worker_->RunStep([&] { RunBackendOn(&work, finished, frame_id, &stats, &events); });
   }
   const Matrix7d chain_information = backend_.FallbackInformation();
   // The result, under the lock again: keyframes made meanwhile move with their map.

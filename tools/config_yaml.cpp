@@ -175,6 +175,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"snapshot_keyframe_poses", Set(&o->realtime.snapshot_keyframe_poses)},
         {"backend_threads", Set(&o->realtime.backend_threads)},
         {"backend_nice", Set(&o->realtime.backend_nice)},
+        {"backend_drain_threads", Set(&o->realtime.backend_drain_threads)},
         {"catch_up_refinements", Set(&o->realtime.catch_up_refinements)},
         {"answer_start_at_once", Set(&o->realtime.answer_start_at_once)},
         {"max_queued_start_frames", Set(&o->realtime.max_queued_start_frames)}}},

@@ -16,6 +16,7 @@
 #include <string>
 #include <thread>
 
+#include "backend/arena_width.hpp"
 #include "backend/backend_worker.hpp"
 #include "backend/mapping_worker.hpp"
 #include "backend/system.hpp"
@@ -96,8 +97,8 @@ TEST(MappingWorker, AWaitedJobHasTheWiderArena) {
       4, 1, 2, 2);
   worker.Offer(Job(1));
   worker.Run(Job(2));
-  EXPECT_EQ(widths, (std::vector<int>{1, MappingWorker::ArenaWidth(2)}));
-  EXPECT_GE(MappingWorker::ArenaWidth(2), 1);  // 2, or 1 under ThreadSanitizer
+  EXPECT_EQ(widths, (std::vector<int>{1, ArenaWidth(2)}));
+  EXPECT_GE(ArenaWidth(2), 1);  // 2, or 1 under ThreadSanitizer
 }
 
 TEST(MappingWorker, StopDropsWaitingJobsAndRefusesNewOnes) {
@@ -176,7 +177,7 @@ TEST(MappingWorker, QueuedJobsAreNeverSkippedAndWaitOnlyWhenTheQueueIsFull) {
   // Queued jobs have the wider arena (the caller's thread is idle); the keyframe request
   // has the keyframe arena (one thread here); a refinement has the narrow one
   // (AWaitedJobHasTheWiderArena).
-  const int wide = MappingWorker::ArenaWidth(2);
+  const int wide = ArenaWidth(2);
   EXPECT_EQ(widths, (std::vector<int>{wide, wide, wide, wide, 1, wide}));
   // Each job knows whether newer ones waited behind it when mapping took it: 1-3 had the
   // keyframe request behind them, 4 was the last (0 may have been taken before the others
@@ -215,7 +216,7 @@ TEST(BackendWorker, RunsOncePerBurstOfRequestsAndAgainForLaterOnes) {
         gate.wait();
         ++runs;
       },
-      1, 10);
+      1, 1, 10);
   worker.Notify();
   worker.Notify();  // while the first run waits at the gate, or before it started
   worker.Notify();
@@ -236,7 +237,7 @@ TEST(BackendWorker, ExceptionsReachTheCallerAndStopReportsWaitingWork) {
       [&] {
         if (fail) throw std::runtime_error("backend failed");
       },
-      1, 0);
+      1, 1, 0);
   worker.Notify();
   EXPECT_THROW(worker.Drain(), std::runtime_error);
   fail = false;
@@ -245,6 +246,26 @@ TEST(BackendWorker, ExceptionsReachTheCallerAndStopReportsWaitingWork) {
   EXPECT_FALSE(worker.Stop());  // nothing was waiting
   EXPECT_THROW(worker.Notify(), std::logic_error);
   EXPECT_FALSE(worker.Stop());  // idempotent
+}
+
+TEST(BackendWorker, StepsMoveToTheDrainArenaWhileACallerWaits) {
+  std::vector<int> widths;  // written by the worker's thread only, read after Drain
+  BackendWorker* self = nullptr;
+  std::promise<void> started;
+  BackendWorker worker(
+      [&] {
+        self->RunStep([&] { widths.push_back(tbb::this_task_arena::max_concurrency()); });
+        started.set_value();
+        while (!self->Draining()) std::this_thread::yield();  // the caller is in Drain
+        self->RunStep([&] { widths.push_back(tbb::this_task_arena::max_concurrency()); });
+      },
+      1, 2, 0);
+  self = &worker;
+  worker.Notify();
+  started.get_future().wait();
+  worker.Drain();
+  EXPECT_FALSE(worker.Draining());
+  EXPECT_EQ(widths, (std::vector<int>{1, ArenaWidth(2)}));
 }
 
 /// The names of this process's threads (Linux /proc), for the naming test.
@@ -262,7 +283,7 @@ TEST(Workers, TheirThreadsAreNamedForProfilersAndDebuggers) {
   const std::size_t mapping_before = ThreadNames().count("px-mapping");
   const std::size_t backend_before = ThreadNames().count("px-backend");
   MappingWorker mapping([](const MappingJob&) { return FrameResult{}; }, 2, 1, 1, 1);
-  BackendWorker backend([] {}, 1, 0);
+  BackendWorker backend([] {}, 1, 1, 0);
   mapping.Run(Job(1));  // the thread has started (and named itself) once a job has run
   backend.Notify();
   backend.Drain();
