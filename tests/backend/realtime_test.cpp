@@ -261,8 +261,9 @@ TEST(BackendWorker, StepsMoveToTheDrainArenaWhileACallerWaits) {
       },
       1, 2, 0);
   self = &worker;
+  std::future<void> first_step_done = started.get_future();  // before the worker can set it
   worker.Notify();
-  started.get_future().wait();
+  first_step_done.wait();
   worker.Drain();
   EXPECT_FALSE(worker.Draining());
   EXPECT_EQ(widths, (std::vector<int>{1, ArenaWidth(2)}));

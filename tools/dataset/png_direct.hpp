@@ -1,12 +1,12 @@
 #pragma once
 // The PNGs camera sequences come in (8-bit grey or RGB, not interlaced, no colour
 // management), decoded without libpng: the whole file is read at once, the IDAT stream
-// inflated by libdeflate and the rows unfiltered here. libpng inflates through zlib and
-// unfilters through its row pipeline; the frame reader spent 3.7-8.2 ms a 640x480 frame in
-// it (docs/benchmarks.md, "Decoding PNG frames"). The pixels are libpng's for OpenCV's
-// IMREAD_GRAYSCALE (tests/tools/png_direct_test.cpp compares them); every other PNG, and
-// every file with anything unexpected in it, is left to libpng (tools/dataset/png_codec.cpp),
-// which decodes it or refuses it with its own message.
+// inflated by libdeflate and the rows unfiltered here, where libpng goes through zlib and
+// its row pipeline at about twice the cost (docs/benchmarks.md, "Decoding PNG frames").
+// The pixels are libpng's for OpenCV's IMREAD_GRAYSCALE (tests/tools/png_direct_test.cpp
+// compares them); every other PNG, and every file with anything unexpected in it, is left
+// to libpng (tools/dataset/png_codec.cpp), which decodes it or refuses it with its own
+// message.
 
 #include <cstddef>
 #include <cstdint>
