@@ -23,6 +23,10 @@ SE3d FrameTracker::VelocityOver(double gap) const {
   return SE3d::Exp(ratio * state_.T_prev_last.Log());
 }
 
+SE3d FrameTracker::Predicted(double timestamp) const {
+  return state_.T_kf_last * VelocityOver(timestamp - state_.last_timestamp);
+}
+
 TrackingResult FrameTracker::Track(const TrackingReference& reference, const Frame& frame) {
   const double gap = frame.Timestamp() - state_.last_timestamp;  // NaN after no frame
   TrackingResult tracked = tracker_.Track(

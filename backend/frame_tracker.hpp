@@ -76,6 +76,9 @@ class FrameTracker {
   /// "Re-acquisition").
   bool Reacquires(const TrackingResult& result) const;
 
+  /// The motion model's guess of a frame at `timestamp`: the last pose moved on by the
+  /// velocity over the time since it (T_kf_frame).
+  SE3d Predicted(double timestamp) const;
   /// A new keyframe: pose and velocity restart at identity, no frame tracked in it yet.
   void StartKeyframe();
   const MotionState& State() const { return state_; }

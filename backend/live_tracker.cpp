@@ -1,5 +1,6 @@
 #include "backend/live_tracker.hpp"
 
+#include <cmath>
 #include <optional>
 
 namespace parallax {
@@ -7,6 +8,38 @@ namespace parallax {
 LiveSnapshot LiveTracker::Latest() {
   const std::lock_guard<std::mutex> lock(mutex);
   return snapshot;
+}
+
+namespace {
+
+// Brightness relative to a reference whose own brightness is `r` (see LiveBridge), and back.
+AffineBrightness RelativeTo(const AffineBrightness& x, const AffineBrightness& r) {
+  const float a = x.a - r.a;
+  return AffineBrightness{a, x.b - std::exp(a) * r.b};
+}
+
+AffineBrightness Compose(const AffineBrightness& x, const AffineBrightness& r) {
+  return AffineBrightness{x.a + r.a, x.b + std::exp(x.a) * r.b};
+}
+
+}  // namespace
+
+MotionState LiveBridge::ToBridge(MotionState m) const {
+  m.T_kf_last = T_kf_bridge.Inverse() * m.T_kf_last;
+  m.affine = RelativeTo(m.affine, affine);
+  return m;
+}
+
+MotionState LiveBridge::FromBridge(MotionState m) const {
+  m.T_kf_last = T_kf_bridge * m.T_kf_last;
+  m.affine = Compose(m.affine, affine);
+  return m;
+}
+
+TrackingResult LiveBridge::FromBridge(TrackingResult t) const {
+  t.T_kf_frame = T_kf_bridge * t.T_kf_frame;
+  t.affine = Compose(t.affine, affine);
+  return t;
 }
 
 void LiveTracker::Follow(const LiveSnapshot& s) {

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -36,6 +37,35 @@ struct LiveSnapshot {
   /// Of the current keyframe's depth (the keyframe rule's distance).
   ParallaxMoments parallax{1.0, 1.0, 0.0, 0.0, 0.0};
   std::uint64_t generation = 0;  ///< System::map_generation_
+  /// Stereo updates the current keyframe's depth has had (InverseDepthMap::updates).
+  std::uint32_t keyframe_updates = 0;
+};
+
+/// A reference at the frame that asked for a keyframe: the keyframe's tracking points moved
+/// into it (TrackingReference::MovedTo). Tracking reads it until the mapping thread has made
+/// and published that keyframe, instead of waiting for it (docs/realtime.md, "The bridge").
+struct LiveBridge {
+  std::int64_t keyframe_id = -1;  ///< the keyframe its depth was moved from
+  std::uint64_t generation = 0;   ///< ... and that keyframe's map generation
+  std::int64_t frame_id = -1;     ///< the frame it stands at
+  SE3d T_kf_bridge;               ///< that frame's pose in the keyframe
+  AffineBrightness affine;        ///< that frame's brightness relative to the keyframe
+  std::shared_ptr<const TrackingReference> reference;
+  /// A frame was overdue on the keyframe: tracking reads the bridge until the keyframe
+  /// exists (before that, the keyframe itself).
+  bool engaged = false;
+
+  /// Whether it was moved from the snapshot's keyframe (and map generation).
+  bool Serves(const LiveSnapshot& s) const {
+    return reference && keyframe_id == s.keyframe_id && generation == s.generation;
+  }
+  /// A motion state in the keyframe re-expressed at the bridge's frame, and back (a rigid
+  /// change of reference; brightness relative to the bridge's frame: I_frame = e^a' I_bridge
+  /// + b' with a' = a - a_bridge, b' = b - e^a' b_bridge).
+  MotionState ToBridge(MotionState m) const;
+  MotionState FromBridge(MotionState m) const;
+  /// A tracking result on the bridge re-expressed in the keyframe.
+  TrackingResult FromBridge(TrackingResult t) const;
 };
 
 /// The caller's side: its own motion state, TBB arena and counters, and the snapshot.
@@ -60,8 +90,11 @@ struct LiveTracker {
   /// The mapping thread's: the keyframe of its last snapshot, and the one before it.
   std::int64_t published_keyframe_id = -1;
   std::int64_t published_previous_id = -1;
-  std::mutex mutex;  ///< guards `snapshot` (written by the mapping thread)
+  std::int64_t tracked_on_bridge = 0;  ///< frames tracked on a LiveBridge
+  std::mutex mutex;                    ///< guards `snapshot` (written by the mapping thread)
   LiveSnapshot snapshot;
+  /// The bridge of the keyframe request pending (the caller's own; empty: none).
+  std::optional<LiveBridge> bridge;
 
   LiveSnapshot Latest();
   /// The state continues in the published keyframe: a new keyframe re-expresses the last

@@ -42,6 +42,7 @@ namespace parallax {
 struct MappingJob;
 struct LiveTracking;
 struct LiveSnapshot;
+struct LiveBridge;
 class MappingWorker;
 class BackendWorker;
 struct LiveTracker;
@@ -145,6 +146,27 @@ class System {
     bool overdue = false;  ///< past the rule by keyframe_wait_factor: the keyframe must exist
   };
   LiveStep TrackLive(const Frame& frame, const LiveSnapshot& snapshot);
+  /// The same on the bridge (its step's pose and brightness re-expressed in the keyframe;
+  /// `overdue` measured from the bridge's frame, `keep` false).
+  LiveStep TrackOnBridge(const Frame& frame, const LiveSnapshot& snapshot,
+                         const LiveBridge& bridge);
+  /// The bridge made for the keyframe request pending in the snapshot's keyframe (null:
+  /// none).
+  LiveBridge* PendingBridge(const LiveSnapshot& snapshot);
+  /// A live frame tracked on the keyframe, or on the pending bridge once a frame was
+  /// overdue on the keyframe (measured, or predicted by PredictedOverdue); `before`: the
+  /// tracker's state before the frame.
+  LiveStep TrackKeyframeOrBridge(const Frame& frame, const LiveSnapshot& snapshot,
+                                 const MotionState& before);
+  /// Whether the motion model's guess for `frame` is already past the keyframe rule's
+  /// distance or turn by keyframe_wait_factor (the overdue test without the tracking
+  /// statistics).
+  bool PredictedOverdue(const Frame& frame, const LiveSnapshot& snapshot) const;
+  /// The tracking call of TrackLive and TrackOnBridge: timed, divergence reported as lost.
+  LiveStep TrackOn(const TrackingReference& reference, const Frame& frame);
+  /// The keyframe rule (keep) and its overdue test on a live tracking result `t` whose pose
+  /// is relative to the reference the rule is measured from.
+  void JudgeKeyframeRule(const LiveSnapshot& snapshot, LiveStep* step) const;
   /// Waits for mapping to finish the frame that asked for a keyframe; returns the wait (ms).
   double WaitForRequestedKeyframe();
   /// Records the live pose and hands the frame to mapping.

@@ -55,6 +55,16 @@ struct RealtimeOptions {
   /// keyframe exists, tracking waits for it (unthrottled input would otherwise outrun the
   /// map: measured 12.9% of path on a 300-frame orbit without the wait).
   double keyframe_wait_factor = 1.5;
+  /// A frame that asks for a keyframe becomes a bridge for the live tracker: the keyframe's
+  /// tracking points moved into it (LiveBridge). Tracking reads it instead of waiting once a
+  /// frame is overdue, until the keyframe exists, and waits only when it is past the rule
+  /// (by keyframe_wait_factor) from the bridge's frame too. Off: chosen on a tuning set, it
+  /// lost accuracy unthrottled on fast motion in the judging set (docs/realtime.md).
+  bool bridge_keyframe_requests = false;
+  /// ... only when the keyframe's depth has had at least this many updates: a mapping
+  /// thread that falls behind (refining little between keyframes) is waited for, as without
+  /// the bridge, rather than outrun.
+  int bridge_min_keyframe_updates = 1;
   /// The snapshot carries the world poses of this many newest finished keyframes, so that
   /// the live state can follow keyframe changes it did not see (docs/realtime.md).
   int snapshot_keyframe_poses = 8;

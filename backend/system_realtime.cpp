@@ -1,5 +1,6 @@
-// System, real-time mode (docs/realtime.md): tracking on the caller's thread against the
-// keyframe the mapping thread last published; everything else on the mapping thread.
+// System, real-time mode (docs/realtime.md): starting and ending the threads, the mapping
+// thread's jobs, the backend's batches and the snapshot live tracking reads (the caller's
+// side is system_live.cpp).
 
 #include <chrono>
 #include <opencv2/core/utility.hpp>
@@ -9,7 +10,6 @@
 #include "backend/mapping_worker.hpp"
 #include "backend/system.hpp"
 #include "core/check.hpp"
-#include "core/divergence.hpp"
 #include "core/stopwatch.hpp"
 
 namespace parallax {
@@ -30,6 +30,8 @@ void RealtimeOptions::Check() const {
   CheckOption(opencv_threads >= 1, "RealtimeOptions", "opencv_threads", "must be >= 1");
   CheckOption(keyframe_wait_factor >= 1.0, "RealtimeOptions", "keyframe_wait_factor",
               "must be >= 1");
+  CheckOption(bridge_min_keyframe_updates >= 0, "RealtimeOptions", "bridge_min_keyframe_updates",
+              "must be >= 0");
   CheckOption(snapshot_keyframe_poses >= 0, "RealtimeOptions", "snapshot_keyframe_poses",
               "must be >= 0");
   CheckOption(backend_threads >= 1, "RealtimeOptions", "backend_threads", "must be >= 1");
@@ -105,6 +107,7 @@ RealtimeStats System::Realtime() const {
   stats.frames_mapped_waiting = live_->mapped_waiting;
   stats.frames_queued_for_start = live_->queued_for_start;
   stats.frames_waiting_for_keyframe = live_->waited_for_keyframe;
+  stats.frames_tracked_on_bridge = live_->tracked_on_bridge;
   stats.frames_skipped_by_mapping = worker_->Skipped() + live_->caught_up.load();
   return stats;
 }
@@ -154,125 +157,6 @@ LiveSnapshot System::CatchUpWithStart(LiveSnapshot snapshot) {
   snapshot = live_->Latest();
   live_->Adopt(snapshot);
   return snapshot;
-}
-
-FrameResult System::ProcessLive(std::int64_t id, double timestamp, const ImageU8& image) {
-  LiveSnapshot snapshot = CatchUpWithStart(live_->Latest());
-  if (!snapshot.usable && options_.realtime.answer_start_at_once) {
-    return QueueStartFrame(id, timestamp, image);
-  }
-  std::shared_ptr<const Frame> frame;
-  live_->arena.execute([&] {
-    frame = std::make_shared<const Frame>(id, timestamp, camera_, image, options_.pyramid);
-  });
-  if (!snapshot.usable) return WaitForMapping(frame, image, std::nullopt, LiveTracking{});
-  live_->Follow(snapshot);
-  const MotionState before = live_->tracker.State();
-  LiveStep step = TrackLive(*frame, snapshot);
-  if (step.tracked.status != TrackingStatus::kLost && !live_->tracker.Reacquires(step.tracked) &&
-      live_->previous_lost) {
-    // As System::TrackFrame: right after a loss only a confident match re-acquires.
-    live_->tracker.SetState(before);
-    step.tracked.status = TrackingStatus::kLost;
-    step.overdue = false;
-    step.keep = false;
-  }
-  if (step.overdue && live_->keyframe_request_frame >= 0) {
-    // The keyframe this one needs was asked for by an earlier frame: wait until mapping
-    // has made it (only that job, not the refinements or the backend behind it), then
-    // track the frame again against it.
-    const double waited_ms = WaitForRequestedKeyframe();
-    const LiveSnapshot next = live_->Latest();
-    if (next.usable && next.keyframe_id != snapshot.keyframe_id) {
-      live_->tracker.SetState(before);
-      snapshot = next;
-      live_->Follow(snapshot);
-      const double first_ms = step.tracking_ms;
-      step = TrackLive(*frame, snapshot);
-      step.tracking_ms += first_ms + waited_ms;
-    }
-  }
-  if (step.tracked.status == TrackingStatus::kLost) {
-    // Lost: the mapping thread tracks it again from the live tracker's motion, then tries
-    // the recent keyframes and relocalisation with the whole map.
-    return WaitForMapping(frame, image, std::nullopt,
-                          LiveTracking{snapshot.keyframe_id, step.tracked, live_->tracker.State(),
-                                       snapshot.generation});
-  }
-  if (step.overdue) {
-    // Still past the rule with no new keyframe: this frame is mapped (and tracked again)
-    // after the waiting jobs.
-    FrameResult result = WaitForMapping(frame, image, std::nullopt, LiveTracking{});
-    result.tracking_ms += step.tracking_ms;
-    return result;
-  }
-  return AnswerLive(frame, image, snapshot, step);
-}
-
-System::LiveStep System::TrackLive(const Frame& frame, const LiveSnapshot& snapshot) {
-  LiveStep step;
-  const auto start = Clock::now();
-  live_->arena.execute([&] {
-    try {
-      step.tracked = live_->tracker.Track(*snapshot.reference, frame);
-    } catch (const NumericalDivergence& e) {
-      // Lost, with the tracker's state as before: the mapping thread tries the frame again.
-      step.tracked = DivergedTracking(e);
-    }
-  });
-  step.tracking_ms = MillisecondsSince(start);
-  if (step.tracked.status == TrackingStatus::kLost) return step;
-  // The keyframe rule of MapFrame: a frame that wants a new keyframe is never skipped by
-  // mapping (once per keyframe); tracking goes on against the current one meanwhile, which
-  // still tracks (the rule fires well before the view is lost), and follows the new one
-  // when it is published.
-  const TrackingResult& t = step.tracked;
-  const double relative_distance =
-      options_.KeyframeDistance(snapshot.parallax, t.T_kf_frame.Translation());
-  const double rotation_deg = SystemOptions::RotationDeg(t.T_kf_frame);
-  const int frames_in_keyframe = live_->tracker.State().frames_in_keyframe;
-  const bool wants_keyframe =
-      snapshot.initialised &&
-      options_.WantsKeyframe(frames_in_keyframe, relative_distance, rotation_deg, t.stats);
-  step.keep = wants_keyframe && live_->keyframe_requested_in != snapshot.keyframe_id;
-  const double f = options_.realtime.keyframe_wait_factor;
-  step.overdue = wants_keyframe && !step.keep &&
-                 (relative_distance > f * options_.keyframe_distance ||
-                  options_.TurnedPast(frames_in_keyframe, rotation_deg, f) ||
-                  t.stats.usage * f < options_.min_keyframe_usage ||
-                  t.stats.good_ratio * f < options_.min_keyframe_good_ratio);
-  return step;
-}
-
-double System::WaitForRequestedKeyframe() {
-  const auto start = Clock::now();
-  worker_->WaitFor(live_->keyframe_request_frame);
-  ++live_->waited_for_keyframe;
-  return MillisecondsSince(start);
-}
-
-FrameResult System::AnswerLive(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
-                               const LiveSnapshot& snapshot, const LiveStep& step) {
-  if (step.keep) {
-    live_->keyframe_requested_in = snapshot.keyframe_id;
-    live_->keyframe_request_frame = frame->Id();
-  }
-  FrameResult result;
-  result.status = step.tracked.status;
-  result.stats = step.tracked.stats;
-  result.tracking_ms = step.tracking_ms;
-  result.initialising = !snapshot.initialised;
-  result.anchor = AnchoredPose{snapshot.keyframe_id, step.tracked.T_kf_frame};
-  result.T_w_c = (snapshot.S_w_kf * Sim3d(step.tracked.T_kf_frame)).RigidPart();
-  Record(frame->Id(), result);
-  LiveTracking live{snapshot.keyframe_id, step.tracked, live_->tracker.State(),
-                    snapshot.generation};
-  worker_->Offer(MappingJob{frame, image, std::move(live), false, step.keep, LiveTracking{},
-                            live_->previous_lost},
-                 !snapshot.initialised);
-  ++live_->tracked_live;
-  TakePendingEvents(&result);
-  return result;
 }
 
 FrameResult System::MapJob(const MappingJob& job) {
@@ -370,6 +254,7 @@ void System::PublishLive() {
     s.reference = mapper_.Reference();
     s.S_w_kf = CurrentKeyframePose();
     s.parallax = options_.KeyframeMoments(mapper_.Map());
+    s.keyframe_updates = mapper_.Map().updates;
     if (s.keyframe_id != live_->published_keyframe_id) {
       live_->published_previous_id = live_->published_keyframe_id;
       live_->published_keyframe_id = s.keyframe_id;

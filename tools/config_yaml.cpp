@@ -172,6 +172,8 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"keyframe_mapping_threads", Set(&o->realtime.keyframe_mapping_threads)},
         {"opencv_threads", Set(&o->realtime.opencv_threads)},
         {"keyframe_wait_factor", Set(&o->realtime.keyframe_wait_factor)},
+        {"bridge_keyframe_requests", Set(&o->realtime.bridge_keyframe_requests)},
+        {"bridge_min_keyframe_updates", Set(&o->realtime.bridge_min_keyframe_updates)},
         {"snapshot_keyframe_poses", Set(&o->realtime.snapshot_keyframe_poses)},
         {"backend_threads", Set(&o->realtime.backend_threads)},
         {"backend_nice", Set(&o->realtime.backend_nice)},

@@ -131,6 +131,7 @@ void WriteStats(const std::string& path, const RunSummary& s) {
                        {"frames_waiting_for_mapping", s.mapping.frames_mapped_waiting},
                        {"frames_queued_for_start", s.mapping.frames_queued_for_start},
                        {"frames_waiting_for_keyframe", s.mapping.frames_waiting_for_keyframe},
+                       {"frames_tracked_on_bridge", s.mapping.frames_tracked_on_bridge},
                        {"frames_skipped_by_mapping", s.mapping.frames_skipped_by_mapping},
                        {"shutdown_ms", s.shutdown_ms}};
   }

@@ -9,6 +9,7 @@
 
 #include "core/frame.hpp"
 #include "core/image.hpp"
+#include "core/se3.hpp"
 
 namespace parallax {
 
@@ -93,7 +94,21 @@ class TrackingReference {
   /// The finest level with points (levels below it are empty by construction).
   int FinestLevel() const { return finest_level_; }
 
+  /// These points moved into another frame of the same camera, level by level, for tracking
+  /// while that frame's own keyframe is being made (the real-time mode's bridge,
+  /// docs/realtime.md). T_to_kf: this keyframe -> `to`; gain, offset: `to`'s brightness
+  /// relative to this keyframe (I_to = gain I_kf + offset). A point lands on the nearest
+  /// pixel of its level, one pixel inside the border, where `to`'s intensity matches it
+  /// within 20 + 0.7 |gradient| grey levels (as DepthFilter::Propagate: occluded and moving
+  /// points do not); of two on one pixel the nearer stays. Inverse depth in the same unit,
+  /// variance transported as (d_to / d_kf)^4; the points come in raster order.
+  TrackingReference MovedTo(std::shared_ptr<const Frame> to, const SE3d& T_to_kf, float gain,
+                            float offset) const;
+
  private:
+  TrackingReference(std::shared_ptr<const Frame> keyframe, std::vector<ReferenceLevel> levels,
+                    int finest_level);
+
   std::shared_ptr<const Frame> keyframe_;
   std::vector<ReferenceLevel> levels_;
   float mean_idepth_ = 0.0f;
