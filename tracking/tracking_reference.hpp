@@ -89,7 +89,8 @@ class TrackingReference {
   const std::shared_ptr<const Frame>& KeyframePtr() const { return keyframe_; }
   int NumLevels() const { return static_cast<int>(levels_.size()); }
   const ReferenceLevel& Level(int level) const { return levels_[static_cast<std::size_t>(level)]; }
-  /// Mean inverse depth of the level-0 points (1 after scale normalisation).
+  /// Mean inverse depth of the level-0 points (1 after scale normalisation); of a moved
+  /// reference (MovedTo), of its finest level's points.
   float MeanIdepth() const { return mean_idepth_; }
   /// The finest level with points (levels below it are empty by construction).
   int FinestLevel() const { return finest_level_; }
