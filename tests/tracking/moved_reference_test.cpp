@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tests/tracking/render_fixture.hpp"
+#include "tests/tracking/room_shake_fixture.hpp"
 #include "tracking/se3_tracker.hpp"
 #include "tracking/tracking_reference.hpp"
 
@@ -16,25 +17,7 @@ namespace {
 using test::ComparePoses;
 using test::RenderedKeyframe;
 
-class MovedReferenceTest : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    scene_ = std::make_unique<synth::Scene>(synth::MakeScene("room", 3));
-    options_.scene = "room";
-    options_.motion = "shake";
-    options_.frames = 40;
-    keyframe_ = std::make_unique<RenderedKeyframe>(test::RenderTestKeyframe(*scene_, Pose(0)));
-  }
-  static void TearDownTestSuite() {
-    keyframe_.reset();
-    scene_.reset();
-  }
-  static SE3d Pose(int i) { return synth::FramePose(options_, *scene_, i); }
-
-  static inline std::unique_ptr<synth::Scene> scene_;
-  static inline synth::SynthOptions options_;
-  static inline std::unique_ptr<RenderedKeyframe> keyframe_;
-};
+class MovedReferenceTest : public test::RoomShakeKeyframeTest {};
 
 TEST_F(MovedReferenceTest, MovedToItsOwnFrameEveryPointStays) {
   TrackingReferenceOptions options;

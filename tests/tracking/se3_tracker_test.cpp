@@ -8,13 +8,13 @@
 #include <numeric>
 
 #include "tests/tracking/render_fixture.hpp"
+#include "tests/tracking/room_shake_fixture.hpp"
 #include "tracking/photometric_residual.hpp"
 
 namespace parallax {
 namespace {
 
 using test::ComparePoses;
-using test::RenderedKeyframe;
 
 // --- Jacobians -------------------------------------------------------------------------
 
@@ -130,21 +130,8 @@ TEST(PhotometricKernel, APointWhereTheFrameSeesNoInputIsOutsideIt) {
 
 // --- Convergence on renders ------------------------------------------------------------
 
-class Se3TrackerRenderTest : public ::testing::Test {
+class Se3TrackerRenderTest : public test::RoomShakeKeyframeTest {
  protected:
-  static void SetUpTestSuite() {
-    scene_ = std::make_unique<synth::Scene>(synth::MakeScene("room", 3));
-    options_.scene = "room";
-    options_.motion = "shake";
-    options_.frames = 40;
-    keyframe_ = std::make_unique<RenderedKeyframe>(test::RenderTestKeyframe(*scene_, Pose(0)));
-  }
-  static void TearDownTestSuite() {
-    keyframe_.reset();
-    scene_.reset();
-  }
-  static SE3d Pose(int i) { return synth::FramePose(options_, *scene_, i); }
-  static SE3d TrueKfFrame(int i) { return keyframe_->T_w_c.Inverse() * Pose(i); }
   // Perturbation: `degrees` about a fixed axis, translation `fraction` of the scene depth.
   static SE3d Perturb(const SE3d& T, double degrees, double fraction, int variant) {
     const Eigen::Vector3d axes[] = {{1, 0.3, -0.2}, {-0.4, 1, 0.5}, {0.2, -0.6, 1}, {1, 1, 1}};
@@ -154,10 +141,6 @@ class Se3TrackerRenderTest : public ::testing::Test {
         axes[variant].normalized() * degrees * 3.14159265358979 / 180.0;
     return T * SE3d::Exp(xi);
   }
-
-  static inline std::unique_ptr<synth::Scene> scene_;
-  static inline synth::SynthOptions options_;
-  static inline std::unique_ptr<RenderedKeyframe> keyframe_;
 };
 
 TEST_F(Se3TrackerRenderTest, ConvergesFromLargeInitialErrorNoiseFree) {
