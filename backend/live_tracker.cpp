@@ -1,5 +1,6 @@
 #include "backend/live_tracker.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
@@ -68,6 +69,15 @@ void LiveTracker::Follow(const LiveSnapshot& s) {
     m.T_prev_last =
         SE3d(m.T_prev_last.Rotation(), m.T_prev_last.Translation() * S_new_old->Scale());
     m.frames_in_keyframe = s.motion.frames_in_keyframe;
+    tracker.SetState(m);
+  }
+  if (s.keyframe_id == keyframe_request_frame && keyframe_request_sequence >= 0) {
+    // The keyframe this caller asked for: the frames tracked live since its frame count
+    // for the keyframe rule (the mapping thread made it without seeing them; on a bridge
+    // they are many).
+    MotionState m = tracker.State();
+    m.frames_in_keyframe = std::max(m.frames_in_keyframe,
+                                    static_cast<int>(tracked_live - keyframe_request_sequence - 1));
     tracker.SetState(m);
   }
   keyframe_id = s.keyframe_id;

@@ -74,13 +74,14 @@ struct LiveTracker {
 
   FrameTracker tracker;
   tbb::task_arena arena;
-  std::int64_t keyframe_id = -1;             ///< the keyframe `tracker`'s state is in
-  bool followed_initialised = false;         ///< the state adopted came from an initialised map
-  std::int64_t keyframe_requested_in = -1;   ///< a frame asked for a keyframe after this one
-  std::int64_t keyframe_request_frame = -1;  ///< ... that frame's id
-  std::int64_t waited_for_keyframe = 0;      ///< frames that waited for a requested keyframe
-  std::int64_t tracked_live = 0;
-  bool previous_lost = false;  ///< the caller's previous frame got no pose
+  std::int64_t keyframe_id = -1;                ///< the keyframe `tracker`'s state is in
+  bool followed_initialised = false;            ///< the state adopted came from an initialised map
+  std::int64_t keyframe_requested_in = -1;      ///< a frame asked for a keyframe after this one
+  std::int64_t keyframe_request_frame = -1;     ///< ... that frame's id
+  std::int64_t keyframe_request_sequence = -1;  ///< ... and its place in `tracked_live`
+  std::int64_t waited_for_keyframe = 0;         ///< frames that waited for a requested keyframe
+  std::int64_t tracked_live = 0;                ///< frames answered from live tracking, in order
+  bool previous_lost = false;                   ///< the caller's previous frame got no pose
   std::int64_t mapped_waiting = 0;
   std::int64_t queued_for_start = 0;  ///< answered at once, mapped later (the start)
   /// The newest start frame queued for mapping and not yet caught up with (-1: none).

@@ -138,7 +138,13 @@ System::LiveStep System::TrackOnBridge(const Frame& frame, const LiveSnapshot& s
   live_->tracker.SetState(bridge.ToBridge(live_->tracker.State()));
   LiveStep step = TrackOn(*bridge.reference, frame);
   live_->tracker.SetState(bridge.FromBridge(live_->tracker.State()));
-  if (step.tracked.status == TrackingStatus::kLost) return step;
+  if (step.tracked.status != TrackingStatus::kOk) {
+    // Only a confident match on the bridge answers the frame: a bridge holds the keyframe's
+    // depth unrefined by the frames past it, and a poor match on it (a wrong minimum on a fast
+    // turn, measured at 30 degrees off) would otherwise be taken; the keyframe decides instead.
+    step.tracked.status = TrackingStatus::kLost;
+    return step;
+  }
   ++live_->tracked_on_bridge;
   // The keyframe was asked for already: the rule only tells whether the frame has gone so
   // far past the bridge's frame that it must wait for the keyframe.
@@ -189,8 +195,9 @@ FrameResult System::AnswerLive(const std::shared_ptr<const Frame>& frame, const 
   if (step.keep) {
     live_->keyframe_requested_in = snapshot.keyframe_id;
     live_->keyframe_request_frame = frame->Id();
+    live_->keyframe_request_sequence = live_->tracked_live;
     live_->bridge.reset();
-    if (options_.realtime.bridge_keyframe_requests) {
+    if (options_.realtime.bridge_keyframe_requests && step.tracked.status == TrackingStatus::kOk) {
       const TrackingResult& t = step.tracked;
       live_->bridge =
           LiveBridge{snapshot.keyframe_id,

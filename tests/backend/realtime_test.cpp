@@ -426,6 +426,29 @@ TEST(LiveBridge, StatesAndResultsMoveToTheBridgeAndBack) {
   EXPECT_NEAR(in_keyframe.affine.b, m.affine.b, 1e-4f);
 }
 
+// The mapping thread makes the keyframe a live frame asked for without seeing the frames
+// tracked live since (on a bridge, several): the keyframe rule counts them once the live
+// state follows that keyframe, and only for that one.
+TEST(LiveTracker, FollowingTheKeyframeItAskedForCountsTheFramesTrackedSince) {
+  for (const bool asked : {true, false}) {
+    LiveTracker live(Se3TrackerOptions{}, 1);
+    LiveSnapshot first;
+    first.usable = first.initialised = true;
+    first.keyframe_id = 10;
+    live.Follow(first);
+    live.keyframe_request_frame = asked ? 14 : 13;
+    live.keyframe_request_sequence = 100;  // frame 14 was the 101st frame tracked live
+    live.tracked_live = 106;               // ... and frames 15-19 followed it
+    LiveSnapshot next = first;
+    next.keyframe_id = 14;
+    next.previous_keyframe_id = 10;
+    next.S_kf_previous = Sim3d(SE3d(SO3d(), Eigen::Vector3d(-0.2, 0, 0)));
+    next.motion.frames_in_keyframe = 1;  // the mapping thread's count: it saw frame 15
+    live.Follow(next);
+    EXPECT_EQ(live.tracker.State().frames_in_keyframe, asked ? 5 : 1);
+  }
+}
+
 TEST(Realtime, TheStartIsAnsweredAtOnceAndItsFramesArePosedWithTheMap) {
   for (const bool at_once : {true, false}) {
     SystemOptions options = Realtime();
