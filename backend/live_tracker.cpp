@@ -72,9 +72,9 @@ void LiveTracker::Follow(const LiveSnapshot& s) {
     tracker.SetState(m);
   }
   if (s.keyframe_id == keyframe_request_frame && keyframe_request_sequence >= 0) {
-    // The keyframe this caller asked for: the frames tracked live since its frame count
-    // for the keyframe rule (the mapping thread made it without seeing them; on a bridge
-    // they are many).
+    // The keyframe this caller asked for: the keyframe rule counts the frames tracked live
+    // since the frame that asked, which the mapping thread made the keyframe without seeing
+    // (on a bridge, many).
     MotionState m = tracker.State();
     m.frames_in_keyframe = std::max(m.frames_in_keyframe,
                                     static_cast<int>(tracked_live - keyframe_request_sequence - 1));

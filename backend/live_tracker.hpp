@@ -99,7 +99,9 @@ struct LiveTracker {
 
   LiveSnapshot Latest();
   /// The state continues in the published keyframe: a new keyframe re-expresses the last
-  /// pose and velocity through the keyframes' similarity (velocity in the new depth unit).
+  /// pose and velocity through the keyframes' similarity (velocity in the new depth unit);
+  /// following the keyframe made at keyframe_request_frame, the rule's frame count includes
+  /// the frames tracked live since that frame.
   void Follow(const LiveSnapshot& s);
   /// After the mapping thread tracked a frame itself, its state is the newest.
   void Adopt(const LiveSnapshot& s);

@@ -140,8 +140,9 @@ System::LiveStep System::TrackOnBridge(const Frame& frame, const LiveSnapshot& s
   live_->tracker.SetState(bridge.FromBridge(live_->tracker.State()));
   if (step.tracked.status != TrackingStatus::kOk) {
     // Only a confident match on the bridge answers the frame: a bridge holds the keyframe's
-    // depth unrefined by the frames past it, and a poor match on it (a wrong minimum on a fast
-    // turn, measured at 30 degrees off) would otherwise be taken; the keyframe decides instead.
+    // depth unrefined by the frames past it, and a poor match on it can be a wrong minimum
+    // on a fast turn (docs/benchmarks.md, "The bridge's failures traced"); the keyframe
+    // decides instead.
     step.tracked.status = TrackingStatus::kLost;
     return step;
   }
