@@ -80,6 +80,8 @@ struct LiveTracker {
   std::int64_t keyframe_request_frame = -1;     ///< ... that frame's id
   std::int64_t keyframe_request_sequence = -1;  ///< ... and its place in `tracked_live`
   std::int64_t waited_for_keyframe = 0;         ///< frames that waited for a requested keyframe
+  std::int64_t paced_for_keyframe = 0;          ///< ... within the pacing budget
+  double last_tracking_ms = 0.0;                ///< the previous live frame's tracking time
   std::int64_t tracked_live = 0;                ///< frames answered from live tracking, in order
   bool previous_lost = false;                   ///< the caller's previous frame got no pose
   std::int64_t mapped_waiting = 0;

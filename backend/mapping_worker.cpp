@@ -91,6 +91,14 @@ void MappingWorker::WaitFor(std::int64_t frame_id) {
   RethrowFailure();
 }
 
+bool MappingWorker::WaitFor(std::int64_t frame_id, std::chrono::steady_clock::time_point deadline) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  const bool done = idle_.wait_until(
+      lock, deadline, [&] { return done_through_ >= frame_id || stopping_ || failure_; });
+  RethrowFailure();
+  return done && done_through_ >= frame_id;
+}
+
 void MappingWorker::Drain() {
   std::unique_lock<std::mutex> lock(mutex_);
   idle_.wait(lock, [this] { return (queue_.empty() && !busy_) || stopping_; });

@@ -6,6 +6,7 @@
 
 #include <tbb/task_arena.h>
 
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -91,6 +92,8 @@ class MappingWorker {
   /// stopped; rethrows as Offer does. Precondition: that frame's job was queued and is
   /// never skipped (`keep`).
   void WaitFor(std::int64_t frame_id);
+  /// As WaitFor, but returns at `deadline` at the latest: whether that job is done.
+  bool WaitFor(std::int64_t frame_id, std::chrono::steady_clock::time_point deadline);
   /// Returns once every queued job is done (rethrows as Offer does).
   void Drain();
   /// Drops the waiting jobs, lets the running one finish and joins the thread. Idempotent.

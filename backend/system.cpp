@@ -343,7 +343,8 @@ TrackingResult System::TrackFrame(const Frame& frame, FrameResult* result) {
 }
 
 void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
-                      const TrackingResult& tracked, FrameResult* result, DepthWork work) {
+                      const TrackingResult& tracked, FrameResult* result, DepthWork work,
+                      bool keyframe_asked) {
   const auto start = Clock::now();
   // Distance relative to the mean depth (mean idepth is 1 after normalisation): the depth
   // updates' baseline, and the keyframe rule's distance (or, with keyframe_distance_in_image,
@@ -355,11 +356,15 @@ void System::MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& 
   // would be compared with, or replaced by, lives in that keyframe.
   const bool start_pending =
       start_ == StartState::kRandomPairSearch || start_ == StartState::kRandomPairHeld;
+  // A keyframe the live tracker asked for is made although the depth refined since its
+  // snapshot may have moved the rule's distance just below the bound: the live tracker
+  // does not ask twice for one keyframe, and would otherwise wait for it once overdue.
   const bool want_keyframe =
       !start_pending &&
-      options_.WantsKeyframe(tracker_.State().frames_in_keyframe,
-                             options_.KeyframeDistance(parallax, t_kf_frame),
-                             SystemOptions::RotationDeg(tracked.T_kf_frame), tracked.stats);
+      (keyframe_asked ||
+       options_.WantsKeyframe(tracker_.State().frames_in_keyframe,
+                              options_.KeyframeDistance(parallax, t_kf_frame),
+                              SystemOptions::RotationDeg(tracked.T_kf_frame), tracked.stats));
   const bool refines =
       work == DepthWork::kRefine ||
       mapper_.Map().updates < static_cast<std::uint32_t>(options_.realtime.catch_up_refinements);

@@ -32,6 +32,7 @@
 #include "core/image.hpp"
 #include "core/pinhole_camera.hpp"
 #include "core/sim3.hpp"
+#include "core/stopwatch.hpp"
 #include "core/validity_mask.hpp"
 #include "depth/depth_filter.hpp"
 #include "tracking/se3_tracker.hpp"
@@ -169,6 +170,11 @@ class System {
   void JudgeKeyframeRule(const LiveSnapshot& snapshot, LiveStep* step) const;
   /// Waits for mapping to finish the frame that asked for a keyframe; returns the wait (ms).
   double WaitForRequestedKeyframe();
+  /// Pacing (RealtimeOptions::keyframe_pacing_ms): while the keyframe a frame asked for is
+  /// pending, waits for it within the call's budget from `call_start`; returns the snapshot
+  /// to track against (the new keyframe's when it came) and adds the wait to `*waited_ms`.
+  LiveSnapshot PaceForRequestedKeyframe(LiveSnapshot snapshot, StageClock::time_point call_start,
+                                        double* waited_ms);
   /// Records the live pose and hands the frame to mapping.
   FrameResult AnswerLive(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
                          const LiveSnapshot& snapshot, const LiveStep& step);
@@ -249,9 +255,12 @@ class System {
   /// SystemOptions::recent_keyframes); on success the found keyframe is current again.
   std::optional<TrackingResult> TrackRecentKeyframes(const Frame& frame, FrameResult* result);
   TrackingResult TrackFrame(const Frame& frame, FrameResult* result);
+  /// Depth update and keyframe rule for a tracked frame. `keyframe_asked`: the live
+  /// tracker's rule asked for a keyframe at this frame, on the keyframe and map this thread
+  /// has (the real-time mode); its verdict stands.
   void MapFrame(const std::shared_ptr<const Frame>& frame, const ImageU8& image,
                 const TrackingResult& tracked, FrameResult* result,
-                DepthWork work = DepthWork::kRefine);
+                DepthWork work = DepthWork::kRefine, bool keyframe_asked = false);
   /// Makes `frame` the new keyframe (depth propagated to it), or reports kDiverged and keeps
   /// the current one when the propagated map diverged.
   void SwitchKeyframe(const std::shared_ptr<const Frame>& frame, const ImageU8& image,

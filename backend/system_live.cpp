@@ -16,6 +16,7 @@ using Clock = StageClock;
 }  // namespace
 
 FrameResult System::ProcessLive(std::int64_t id, double timestamp, const ImageU8& image) {
+  const auto call_start = Clock::now();
   LiveSnapshot snapshot = CatchUpWithStart(live_->Latest());
   if (!snapshot.usable && options_.realtime.answer_start_at_once) {
     return QueueStartFrame(id, timestamp, image);
@@ -25,9 +26,13 @@ FrameResult System::ProcessLive(std::int64_t id, double timestamp, const ImageU8
     frame = std::make_shared<const Frame>(id, timestamp, camera_, image, options_.pyramid);
   });
   if (!snapshot.usable) return WaitForMapping(frame, image, std::nullopt, LiveTracking{});
+  double paced_ms = 0.0;
+  snapshot = PaceForRequestedKeyframe(std::move(snapshot), call_start, &paced_ms);
   live_->Follow(snapshot);
   const MotionState before = live_->tracker.State();
   LiveStep step = TrackKeyframeOrBridge(*frame, snapshot, before);
+  live_->last_tracking_ms = step.tracking_ms;
+  step.tracking_ms += paced_ms;
   if (step.tracked.status != TrackingStatus::kLost && !live_->tracker.Reacquires(step.tracked) &&
       live_->previous_lost) {
     // As System::TrackFrame: right after a loss only a confident match re-acquires.
@@ -189,6 +194,27 @@ double System::WaitForRequestedKeyframe() {
   worker_->WaitFor(live_->keyframe_request_frame);
   ++live_->waited_for_keyframe;
   return MillisecondsSince(start);
+}
+
+LiveSnapshot System::PaceForRequestedKeyframe(LiveSnapshot snapshot,
+                                              StageClock::time_point call_start,
+                                              double* waited_ms) {
+  const double budget_ms = options_.realtime.keyframe_pacing_ms - live_->last_tracking_ms;
+  if (budget_ms <= 0.0 || live_->keyframe_request_frame < 0 ||
+      live_->keyframe_requested_in != snapshot.keyframe_id) {
+    return snapshot;
+  }
+  const auto deadline = call_start + std::chrono::duration_cast<StageClock::duration>(
+                                         std::chrono::duration<double, std::milli>(budget_ms));
+  if (deadline <= Clock::now()) return snapshot;
+  const auto start = Clock::now();
+  const bool done = worker_->WaitFor(live_->keyframe_request_frame, deadline);
+  *waited_ms += MillisecondsSince(start);
+  LiveSnapshot next = done ? live_->Latest() : LiveSnapshot{};
+  const bool changed = next.usable && next.keyframe_id != snapshot.keyframe_id;
+  // A request mapping answered without a keyframe (its own rule did not fire) paced nothing.
+  if (!done || changed) ++live_->paced_for_keyframe;
+  return changed ? next : snapshot;
 }
 
 FrameResult System::AnswerLive(const std::shared_ptr<const Frame>& frame, const ImageU8& image,

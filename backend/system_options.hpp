@@ -55,6 +55,11 @@ struct RealtimeOptions {
   /// keyframe exists, tracking waits for it (unthrottled input would otherwise outrun the
   /// map: measured 12.9% of path on a 300-frame orbit without the wait).
   double keyframe_wait_factor = 1.5;
+  /// While a requested keyframe is pending, a frame first waits for it until its call has
+  /// taken this long less the previous live frame's tracking time (ms; 0: never), then
+  /// tracks against whichever keyframe is published. Spreads the wait for a keyframe over
+  /// the frames after the request instead of one overdue frame (docs/realtime.md, "Pacing").
+  double keyframe_pacing_ms = 8.0;
   /// A frame that asks for a keyframe becomes a bridge for the live tracker: the keyframe's
   /// tracking points moved into it (LiveBridge). Tracking reads it instead of waiting once a
   /// frame is overdue, until the keyframe exists, and waits only when it is past the rule

@@ -30,6 +30,7 @@ void RealtimeOptions::Check() const {
   CheckOption(opencv_threads >= 1, "RealtimeOptions", "opencv_threads", "must be >= 1");
   CheckOption(keyframe_wait_factor >= 1.0, "RealtimeOptions", "keyframe_wait_factor",
               "must be >= 1");
+  CheckOption(keyframe_pacing_ms >= 0.0, "RealtimeOptions", "keyframe_pacing_ms", "must be >= 0");
   CheckOption(bridge_min_keyframe_updates >= 0, "RealtimeOptions", "bridge_min_keyframe_updates",
               "must be >= 0");
   CheckOption(snapshot_keyframe_poses >= 0, "RealtimeOptions", "snapshot_keyframe_poses",
@@ -107,6 +108,7 @@ RealtimeStats System::Realtime() const {
   stats.frames_mapped_waiting = live_->mapped_waiting;
   stats.frames_queued_for_start = live_->queued_for_start;
   stats.frames_waiting_for_keyframe = live_->waited_for_keyframe;
+  stats.frames_paced_for_keyframe = live_->paced_for_keyframe;
   stats.frames_tracked_on_bridge = live_->tracked_on_bridge;
   stats.frames_skipped_by_mapping = worker_->Skipped() + live_->caught_up.load();
   return stats;
@@ -173,7 +175,7 @@ FrameResult System::MapJob(const MappingJob& job) {
     result.status = job.live->tracked.status;
     result.stats = job.live->tracked.stats;
     SetPose(&result, job.live->tracked.T_kf_frame);
-    MapFrame(job.frame, job.image, job.live->tracked, &result);
+    MapFrame(job.frame, job.image, job.live->tracked, &result, DepthWork::kRefine, job.keep);
     last_posed_timestamp_ = job.frame->Timestamp();
     previous_frame_lost_ = false;
     Record(job.frame->Id(), result);

@@ -70,6 +70,8 @@ struct RealtimeStats {
   std::int64_t frames_queued_for_start = 0;
   /// The caller waited for a keyframe it had asked for, then tracked the frame itself.
   std::int64_t frames_waiting_for_keyframe = 0;
+  /// Frames that waited, within RealtimeOptions::keyframe_pacing_ms, for a pending keyframe.
+  std::int64_t frames_paced_for_keyframe = 0;
   /// Tracked on the bridge at the frame that asked for a keyframe, while mapping made it.
   std::int64_t frames_tracked_on_bridge = 0;
   /// Tracked, never used to refine depth: refinements mapping skipped when behind, and start

@@ -172,6 +172,7 @@ std::map<std::string, Section> Sections(SystemOptions* o) {
         {"keyframe_mapping_threads", Set(&o->realtime.keyframe_mapping_threads)},
         {"opencv_threads", Set(&o->realtime.opencv_threads)},
         {"keyframe_wait_factor", Set(&o->realtime.keyframe_wait_factor)},
+        {"keyframe_pacing_ms", Set(&o->realtime.keyframe_pacing_ms)},
         {"bridge_keyframe_requests", Set(&o->realtime.bridge_keyframe_requests)},
         {"bridge_min_keyframe_updates", Set(&o->realtime.bridge_min_keyframe_updates)},
         {"snapshot_keyframe_poses", Set(&o->realtime.snapshot_keyframe_poses)},

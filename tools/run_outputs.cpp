@@ -118,6 +118,10 @@ void WriteStats(const std::string& path, const RunSummary& s) {
       {"mapping_ms", {{"p50", s.mapping_ms_p50}, {"p95", s.mapping_ms_p95}}},
       {"latency_ms",
        {{"p50", s.latency_ms_p50}, {"p95", s.latency_ms_p95}, {"max", s.latency_ms_max}}},
+      {"tracked_latency_ms",
+       {{"p50", s.tracked_latency_ms_p50},
+        {"p95", s.tracked_latency_ms_p95},
+        {"max", s.tracked_latency_ms_max}}},
       {"map_points", s.map_points},
       {"peak_rss_mb", s.peak_rss_mb},
       {"heap_huge_pages", s.heap_huge_pages},
@@ -131,6 +135,7 @@ void WriteStats(const std::string& path, const RunSummary& s) {
                        {"frames_waiting_for_mapping", s.mapping.frames_mapped_waiting},
                        {"frames_queued_for_start", s.mapping.frames_queued_for_start},
                        {"frames_waiting_for_keyframe", s.mapping.frames_waiting_for_keyframe},
+                       {"frames_paced_for_keyframe", s.mapping.frames_paced_for_keyframe},
                        {"frames_tracked_on_bridge", s.mapping.frames_tracked_on_bridge},
                        {"frames_skipped_by_mapping", s.mapping.frames_skipped_by_mapping},
                        {"shutdown_ms", s.shutdown_ms}};

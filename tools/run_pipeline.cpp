@@ -42,7 +42,7 @@ std::string RunSummary::Outcome() const {
 namespace {
 
 struct Timings {
-  std::vector<double> tracking_ms, mapping_ms, latency_ms;
+  std::vector<double> tracking_ms, mapping_ms, latency_ms, tracked_latency_ms;
 };
 
 /// Figures of the run so far (also for an interrupted or failed one).
@@ -89,6 +89,9 @@ void Summarise(const System& system, const Timings& timings,
   summary->latency_ms_p50 = Percentile(timings.latency_ms, 0.5);
   summary->latency_ms_p95 = Percentile(timings.latency_ms, 0.95);
   summary->latency_ms_max = Percentile(timings.latency_ms, 1.0);
+  summary->tracked_latency_ms_p50 = Percentile(timings.tracked_latency_ms, 0.5);
+  summary->tracked_latency_ms_p95 = Percentile(timings.tracked_latency_ms, 0.95);
+  summary->tracked_latency_ms_max = Percentile(timings.tracked_latency_ms, 1.0);
   summary->mapping = system.Realtime();
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
@@ -181,6 +184,8 @@ RunSummary RunDataset(const RunOptions& options) {
       const auto call = StageClock::now();
       const FrameResult result = system.ProcessFrame(frame->image, frame->timestamp);
       timings.latency_ms.push_back(MillisecondsSince(call));
+      if (!result.answered_before_mapping)
+        timings.tracked_latency_ms.push_back(timings.latency_ms.back());
       outputs.LogFrame(static_cast<int>(frame->index), frame->timestamp, system.NextFrameId() - 1,
                        result);
       timings.tracking_ms.push_back(result.tracking_ms);

@@ -90,6 +90,9 @@ struct RunSummary {
   int backend_steps_diverged = 0;
   /// Wall time of each ProcessFrame call (what a caller waits for a pose), ms.
   double latency_ms_p50 = 0.0, latency_ms_p95 = 0.0, latency_ms_max = 0.0;
+  /// The same over the calls that answered with tracking (a pose, or lost): without the
+  /// start's frames answered before mapping (docs/realtime.md, "The CLI").
+  double tracked_latency_ms_p50 = 0.0, tracked_latency_ms_p95 = 0.0, tracked_latency_ms_max = 0.0;
   /// Real-time mode only.
   bool realtime = false;
   double rate = 0.0;

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -187,6 +188,22 @@ TEST(MappingWorker, QueuedJobsAreNeverSkippedAndWaitOnlyWhenTheQueueIsFull) {
   EXPECT_EQ(std::vector<bool>(newer_waiting.begin() + 1, newer_waiting.begin() + 4),
             (std::vector<bool>{true, true, true}));
   EXPECT_FALSE(newer_waiting.back());
+}
+
+TEST(MappingWorker, AWaitForWithADeadlineSaysWhetherTheJobIsDone) {
+  GatedProcess process;
+  MappingWorker worker(process.Function(), 4, 1, 1, 1);
+  MappingJob kept = Job(3);
+  kept.keep = true;
+  worker.Offer(std::move(kept));
+  const auto start = std::chrono::steady_clock::now();
+  // The gate is closed: job 3 cannot be done, so the wait ends at its deadline.
+  EXPECT_FALSE(worker.WaitFor(3, start + std::chrono::milliseconds(20)));
+  EXPECT_GE(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(20));
+  process.open.set_value();
+  EXPECT_TRUE(worker.WaitFor(3, std::chrono::steady_clock::now() + std::chrono::seconds(60)));
+  // Done already: at once, whatever the deadline.
+  EXPECT_TRUE(worker.WaitFor(3, std::chrono::steady_clock::now()));
 }
 
 TEST(MappingWorker, AWaitForEndsWhenTheWorkerStops) {
@@ -392,6 +409,38 @@ TEST(Realtime, FramesPastAnOverdueKeyframeAreTrackedOnItsBridge) {
     EXPECT_GE(system.Trajectory().size(), static_cast<std::size_t>(frames * 95 / 100));
     EXPECT_LT(OrbitAte(system), 0.05) << (bridge ? "bridge" : "no bridge");
   }
+}
+
+// keyframe_wait_factor 1, as above: without pacing, the frame after a keyframe request is
+// overdue and waits for the keyframe. With a pacing budget that outlasts any keyframe job,
+// that frame waits for the keyframe first (paced) and is tracked against it, so it is not
+// overdue; the frames are posed as well either way.
+TEST(Realtime, PacingWaitsForAPendingKeyframeBeforeTheFrameIsOverdue) {
+  std::int64_t overdue_waits[2] = {0, 0};
+  for (const bool pacing : {false, true}) {
+    SystemOptions options = Realtime();
+    options.realtime.keyframe_wait_factor = 1.0;
+    options.realtime.keyframe_pacing_ms = pacing ? 60000.0 : 0.0;
+    System system(test::TestCamera(), options);
+    const int frames = 80;
+    for (int k = 0; k < frames; ++k) {
+      system.ProcessFrame(test::RenderTestImage(Room(), OrbitPose(k)), k / 30.0);
+    }
+    system.FinishMapping();
+    const RealtimeStats stats = system.Realtime();
+    overdue_waits[pacing ? 1 : 0] = stats.frames_waiting_for_keyframe;
+    if (pacing) {
+      EXPECT_GE(stats.frames_paced_for_keyframe, 3);
+    } else {
+      EXPECT_EQ(stats.frames_paced_for_keyframe, 0);
+    }
+    EXPECT_GE(system.Trajectory().size(), static_cast<std::size_t>(frames * 95 / 100));
+    EXPECT_LT(OrbitAte(system), 0.05) << (pacing ? "pacing" : "no pacing");
+  }
+  // A paced frame overdue nonetheless: only after a request mapping answered without a
+  // keyframe (its own tracking of that frame did not pass the rule).
+  EXPECT_GE(overdue_waits[0], 2);
+  EXPECT_LT(overdue_waits[1] * 3, overdue_waits[0]);
 }
 
 // The live state re-expressed at a bridge's frame and back is the same state, and the
