@@ -212,7 +212,8 @@ LiveSnapshot System::PaceForRequestedKeyframe(LiveSnapshot snapshot,
   *waited_ms += MillisecondsSince(start);
   LiveSnapshot next = done ? live_->Latest() : LiveSnapshot{};
   const bool changed = next.usable && next.keyframe_id != snapshot.keyframe_id;
-  // A request mapping answered without a keyframe (its own rule did not fire) paced nothing.
+  // A request mapping answered without a keyframe (its propagated map diverged, or the
+  // request was made on a keyframe mapping had left) paced nothing.
   if (!done || changed) ++live_->paced_for_keyframe;
   return changed ? next : snapshot;
 }

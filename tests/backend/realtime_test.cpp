@@ -437,8 +437,8 @@ TEST(Realtime, PacingWaitsForAPendingKeyframeBeforeTheFrameIsOverdue) {
     EXPECT_GE(system.Trajectory().size(), static_cast<std::size_t>(frames * 95 / 100));
     EXPECT_LT(OrbitAte(system), 0.05) << (pacing ? "pacing" : "no pacing");
   }
-  // A paced frame overdue nonetheless: only after a request mapping answered without a
-  // keyframe (its own tracking of that frame did not pass the rule).
+  // A paced frame is overdue nonetheless only after a request mapping answered without a
+  // keyframe (a diverged propagation, or a request on a keyframe mapping had left).
   EXPECT_GE(overdue_waits[0], 2);
   EXPECT_LT(overdue_waits[1] * 3, overdue_waits[0]);
 }
