@@ -87,14 +87,13 @@ FrameResult MappingWorker::Run(MappingJob job) {
 
 void MappingWorker::WaitFor(std::int64_t frame_id) {
   std::unique_lock<std::mutex> lock(mutex_);
-  idle_.wait(lock, [&] { return done_through_ >= frame_id || stopping_ || failure_; });
+  idle_.wait(lock, [&] { return DoneOrEnded(frame_id); });
   RethrowFailure();
 }
 
 bool MappingWorker::WaitFor(std::int64_t frame_id, std::chrono::steady_clock::time_point deadline) {
   std::unique_lock<std::mutex> lock(mutex_);
-  const bool done = idle_.wait_until(
-      lock, deadline, [&] { return done_through_ >= frame_id || stopping_ || failure_; });
+  const bool done = idle_.wait_until(lock, deadline, [&] { return DoneOrEnded(frame_id); });
   RethrowFailure();
   return done && done_through_ >= frame_id;
 }

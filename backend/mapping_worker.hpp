@@ -109,6 +109,11 @@ class MappingWorker {
   static bool Skippable(const Entry& e) { return !e.done && !e.job.keep; }
   void Loop();
   void RethrowFailure();  // precondition: mutex_ held
+  /// The job of `frame_id` (or a later frame's) is done, or the worker stopped or failed
+  /// (precondition: mutex_ held).
+  bool DoneOrEnded(std::int64_t frame_id) const {
+    return done_through_ >= frame_id || stopping_ || failure_;
+  }
 
   Process process_;
   std::size_t max_pending_;

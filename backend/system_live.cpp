@@ -206,8 +206,8 @@ LiveSnapshot System::PaceForRequestedKeyframe(LiveSnapshot snapshot,
   }
   const auto deadline = call_start + std::chrono::duration_cast<StageClock::duration>(
                                          std::chrono::duration<double, std::milli>(budget_ms));
-  if (deadline <= Clock::now()) return snapshot;
   const auto start = Clock::now();
+  if (deadline <= start) return snapshot;
   const bool done = worker_->WaitFor(live_->keyframe_request_frame, deadline);
   *waited_ms += MillisecondsSince(start);
   LiveSnapshot next = done ? live_->Latest() : LiveSnapshot{};

@@ -383,6 +383,23 @@ TEST(Realtime, AnOrbitFedAsFastAsTrackingGoesIsPosedInOneWorld) {
   EXPECT_GT(system.Realtime().frames_tracked_live, frames / 2);
 }
 
+/// What a real-time System made of the rendered orbit's first `frames` frames, fed as fast
+/// as it takes them.
+struct OrbitRun {
+  RealtimeStats stats;
+  std::size_t posed = 0;
+  double ate = 0.0;
+};
+
+OrbitRun RunOrbit(const SystemOptions& options, int frames) {
+  System system(test::TestCamera(), options);
+  for (int k = 0; k < frames; ++k) {
+    system.ProcessFrame(test::RenderTestImage(Room(), OrbitPose(k)), k / 30.0);
+  }
+  system.FinishMapping();
+  return {system.Realtime(), system.Trajectory().size(), OrbitAte(system)};
+}
+
 // keyframe_wait_factor 1: a frame after the one that asked for a keyframe is overdue while it
 // is still past the rule. Without bridges it waits until mapping has made the keyframe; with
 // them it is tracked on the requesting frame (the keyframe's points moved there) and waits
@@ -393,21 +410,16 @@ TEST(Realtime, FramesPastAnOverdueKeyframeAreTrackedOnItsBridge) {
     options.realtime.keyframe_wait_factor = 1.0;
     options.realtime.bridge_keyframe_requests = bridge;
     options.realtime.bridge_min_keyframe_updates = 0;  // the mechanism, whatever mapping's pace
-    System system(test::TestCamera(), options);
-    const int frames = 80;
-    for (int k = 0; k < frames; ++k) {
-      system.ProcessFrame(test::RenderTestImage(Room(), OrbitPose(k)), k / 30.0);
-    }
-    system.FinishMapping();
-    const RealtimeStats stats = system.Realtime();
+    const OrbitRun run = RunOrbit(options, 80);
+    const RealtimeStats& stats = run.stats;
     if (bridge) {
       EXPECT_GT(stats.frames_tracked_on_bridge, 0);
     } else {
       EXPECT_EQ(stats.frames_tracked_on_bridge, 0);
       EXPECT_GT(stats.frames_waiting_for_keyframe, 0);
     }
-    EXPECT_GE(system.Trajectory().size(), static_cast<std::size_t>(frames * 95 / 100));
-    EXPECT_LT(OrbitAte(system), 0.05) << (bridge ? "bridge" : "no bridge");
+    EXPECT_GE(run.posed, static_cast<std::size_t>(80 * 95 / 100));
+    EXPECT_LT(run.ate, 0.05) << (bridge ? "bridge" : "no bridge");
   }
 }
 
@@ -421,21 +433,16 @@ TEST(Realtime, PacingWaitsForAPendingKeyframeBeforeTheFrameIsOverdue) {
     SystemOptions options = Realtime();
     options.realtime.keyframe_wait_factor = 1.0;
     options.realtime.keyframe_pacing_ms = pacing ? 60000.0 : 0.0;
-    System system(test::TestCamera(), options);
-    const int frames = 80;
-    for (int k = 0; k < frames; ++k) {
-      system.ProcessFrame(test::RenderTestImage(Room(), OrbitPose(k)), k / 30.0);
-    }
-    system.FinishMapping();
-    const RealtimeStats stats = system.Realtime();
+    const OrbitRun run = RunOrbit(options, 80);
+    const RealtimeStats& stats = run.stats;
     overdue_waits[pacing ? 1 : 0] = stats.frames_waiting_for_keyframe;
     if (pacing) {
       EXPECT_GE(stats.frames_paced_for_keyframe, 3);
     } else {
       EXPECT_EQ(stats.frames_paced_for_keyframe, 0);
     }
-    EXPECT_GE(system.Trajectory().size(), static_cast<std::size_t>(frames * 95 / 100));
-    EXPECT_LT(OrbitAte(system), 0.05) << (pacing ? "pacing" : "no pacing");
+    EXPECT_GE(run.posed, static_cast<std::size_t>(80 * 95 / 100));
+    EXPECT_LT(run.ate, 0.05) << (pacing ? "pacing" : "no pacing");
   }
   // A paced frame is overdue nonetheless only after a request mapping answered without a
   // keyframe (a diverged propagation, or a request on a keyframe mapping had left).
